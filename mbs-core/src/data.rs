@@ -1,0 +1,121 @@
+//! [`Data`]: the preallocated workspace of the algorithms.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::model::{BodyId, Model};
+use crate::spatial::{ArticulatedInertia, Force, Inertia, Motion, Transform};
+
+/// The mutable workspace of the algorithms for one [`Model`]: every buffer is allocated here
+/// once, so evaluating the dynamics allocates nothing. Per-body arrays are indexed by
+/// [`BodyId::index`] (0 = ground); joint-space vectors by coordinate.
+///
+/// Results stay in the workspace after a call (`data.tau()`, `data.qdd()`,
+/// `data.mass_matrix()`, body poses and velocities) until the next call overwrites them.
+#[derive(Clone, Debug)]
+pub struct Data {
+    /// Pose of each body's joint frame in its parent's joint frame.
+    pub(crate) x_up: Vec<Transform>,
+    /// Pose of each body's joint frame in the world.
+    pub(crate) x_world: Vec<Transform>,
+    /// Spatial velocity of each body, in its own frame.
+    pub(crate) v: Vec<Motion>,
+    /// Spatial acceleration of each body, in its own frame.
+    pub(crate) a: Vec<Motion>,
+    /// Net spatial force transmitted by each joint (RNEA), in the body frame.
+    pub(crate) f: Vec<Force>,
+    /// Composite rigid-body inertias (CRBA).
+    pub(crate) ic: Vec<Inertia>,
+    /// Articulated-body inertias (ABA).
+    pub(crate) ia: Vec<ArticulatedInertia>,
+    /// Articulated bias forces (ABA).
+    pub(crate) pa: Vec<Force>,
+    /// Velocity-product accelerations `v ×ₘ S q̇` (ABA).
+    pub(crate) c: Vec<Motion>,
+    /// `U = IA S` per body (ABA).
+    pub(crate) u_col: Vec<Force>,
+    /// `1 / (Sᵀ U)` per body (ABA).
+    pub(crate) d_inv: Vec<f64>,
+    /// `u = τ − Sᵀ pA` per body (ABA).
+    pub(crate) u: Vec<f64>,
+    pub(crate) tau: DVector<f64>,
+    pub(crate) qdd: DVector<f64>,
+    pub(crate) nle: DVector<f64>,
+    pub(crate) gravity: DVector<f64>,
+    pub(crate) mass_matrix: DMatrix<f64>,
+    /// Tree-sparse LᵀL factor of the mass matrix, in body order.
+    pub(crate) factor: Vec<f64>,
+    /// Right-hand side / solution in body order.
+    pub(crate) rhs: Vec<f64>,
+}
+
+impl Data {
+    /// A workspace sized for `model`.
+    pub fn new(model: &Model) -> Self {
+        let nb = model.nbodies();
+        let nv = model.nv();
+        Self {
+            x_up: vec![Transform::IDENTITY; nb],
+            x_world: vec![Transform::IDENTITY; nb],
+            v: vec![Motion::ZERO; nb],
+            a: vec![Motion::ZERO; nb],
+            f: vec![Force::ZERO; nb],
+            ic: vec![Inertia::ZERO; nb],
+            ia: vec![ArticulatedInertia::default(); nb],
+            pa: vec![Force::ZERO; nb],
+            c: vec![Motion::ZERO; nb],
+            u_col: vec![Force::ZERO; nb],
+            d_inv: vec![0.0; nb],
+            u: vec![0.0; nb],
+            tau: DVector::zeros(nv),
+            qdd: DVector::zeros(nv),
+            nle: DVector::zeros(nv),
+            gravity: DVector::zeros(nv),
+            mass_matrix: DMatrix::zeros(nv, nv),
+            factor: vec![0.0; nv * nv],
+            rhs: vec![0.0; nv],
+        }
+    }
+
+    /// Generalized forces from the last [`crate::rnea`] (or the driving forces and given
+    /// forces of [`crate::hybrid_dynamics`]).
+    pub fn tau(&self) -> &DVector<f64> {
+        &self.tau
+    }
+
+    /// Generalized accelerations from the last forward-dynamics call.
+    pub fn qdd(&self) -> &DVector<f64> {
+        &self.qdd
+    }
+
+    /// Joint-space mass matrix from the last [`crate::crba`] (full, symmetric).
+    pub fn mass_matrix(&self) -> &DMatrix<f64> {
+        &self.mass_matrix
+    }
+
+    /// Nonlinear effects `C(q, v) v + g(q)` from the last [`crate::nonlinear_effects`].
+    pub fn nonlinear_effects(&self) -> &DVector<f64> {
+        &self.nle
+    }
+
+    /// Gravity generalized forces `g(q)` from the last [`crate::gravity_torque`].
+    pub fn gravity_torque(&self) -> &DVector<f64> {
+        &self.gravity
+    }
+
+    /// World pose of a body's joint frame (after [`crate::forward_kinematics`] or
+    /// [`crate::update_poses`]).
+    pub fn body_pose(&self, body: BodyId) -> Transform {
+        self.x_world[body.0]
+    }
+
+    /// Spatial velocity of a body in its own frame (after a kinematics or dynamics call).
+    pub fn body_velocity(&self, body: BodyId) -> Motion {
+        self.v[body.0]
+    }
+
+    /// Spatial acceleration of a body in its own frame, gravity excluded (after
+    /// [`crate::forward_kinematics_acc`]).
+    pub fn body_acceleration(&self, body: BodyId) -> Motion {
+        self.a[body.0]
+    }
+}

@@ -1,0 +1,436 @@
+//! Standard force elements: joint spring–damper, point-to-point spring–damper, pivot
+//! friction, and loads applied as functions of time.
+
+use std::sync::Arc;
+
+use crate::error::{CoreError, Result};
+use crate::force::{Crossing, ForceContext, ForceElement, Loads};
+use crate::kinematics::frame_point;
+use crate::model::{BodyId, Model};
+use crate::time_function::TimeFunction;
+
+fn param(item: &str, field: &str, value: f64, nonneg: bool) -> Result<f64> {
+    if !value.is_finite() {
+        return Err(CoreError::InvalidParameter {
+            item: format!("{item}.{field}"),
+            message: format!("must be finite, got {value}"),
+        });
+    }
+    if nonneg && value < 0.0 {
+        return Err(CoreError::InvalidParameter {
+            item: format!("{item}.{field}"),
+            message: format!("must be non-negative, got {value}"),
+        });
+    }
+    Ok(value)
+}
+
+/// Linear spring–damper parameters shared by the spring elements.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpringLaw {
+    /// Stiffness (N·m/rad, or N/m), non-negative.
+    pub stiffness: f64,
+    /// Damping (N·m·s/rad, or N·s/m), non-negative.
+    pub damping: f64,
+    /// Rest angle, displacement or length.
+    pub rest: f64,
+    /// Force or torque the spring exerts at its rest position.
+    pub preload: f64,
+}
+
+impl SpringLaw {
+    /// A spring with the given stiffness and rest value, no damping, no preload.
+    pub fn new(stiffness: f64, rest: f64) -> Self {
+        Self {
+            stiffness,
+            rest,
+            ..Self::default()
+        }
+    }
+
+    /// The same spring with damping `damping`.
+    pub fn with_damping(self, damping: f64) -> Self {
+        Self { damping, ..self }
+    }
+
+    /// The same spring with preload `preload`.
+    pub fn with_preload(self, preload: f64) -> Self {
+        Self { preload, ..self }
+    }
+
+    fn validated(self, item: &str, rest_nonneg: bool) -> Result<Self> {
+        Ok(Self {
+            stiffness: param(item, "stiffness", self.stiffness, true)?,
+            damping: param(item, "damping", self.damping, true)?,
+            rest: param(item, "rest", self.rest, rest_nonneg)?,
+            preload: param(item, "preload", self.preload, false)?,
+        })
+    }
+}
+
+/// A torsional (or linear, on a prismatic joint) spring–damper on one joint:
+/// `τ = preload − k (q − rest) − c q̇`. The preload is the generalized force the spring
+/// exerts at its rest position (a pre-tensioned spring), signed along the coordinate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointSpringDamper {
+    name: String,
+    coordinate: usize,
+    law: SpringLaw,
+}
+
+impl JointSpringDamper {
+    /// A spring–damper on the joint named `joint`; stiffness and damping must be
+    /// non-negative and everything finite.
+    pub fn new(model: &Model, joint: &str, law: SpringLaw) -> Result<Self> {
+        let name = format!("joint spring '{joint}'");
+        Ok(Self {
+            coordinate: model.coordinate_id(joint)?,
+            law: law.validated(&name, false)?,
+            name,
+        })
+    }
+
+    /// The generalized force for coordinate value `q` and rate `v`.
+    pub fn force(&self, q: f64, v: f64) -> f64 {
+        let l = &self.law;
+        l.preload - l.stiffness * (q - l.rest) - l.damping * v
+    }
+}
+
+impl ForceElement for JointSpringDamper {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
+        let k = self.coordinate;
+        loads.add_generalized(k, self.force(ctx.q[k], ctx.v[k]));
+    }
+
+    fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
+        let d = ctx.q[self.coordinate] - self.law.rest;
+        0.5 * self.law.stiffness * d * d - self.law.preload * d
+    }
+}
+
+/// One end of a point-to-point element: a frame name (`None` for the ground) and a point
+/// given in that frame (in world coordinates for the ground).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attachment<'a> {
+    /// Frame name, `None` for the ground.
+    pub frame: Option<&'a str>,
+    /// Point in the frame.
+    pub point: [f64; 2],
+}
+
+impl<'a> Attachment<'a> {
+    /// A point fixed to the named frame.
+    pub fn on(frame: &'a str, point: [f64; 2]) -> Self {
+        Self {
+            frame: Some(frame),
+            point,
+        }
+    }
+
+    /// A point fixed to the ground (world coordinates).
+    pub fn ground(point: [f64; 2]) -> Self {
+        Self { frame: None, point }
+    }
+
+    fn resolve(&self, model: &Model, item: &str) -> Result<(BodyId, [f64; 2])> {
+        param(item, "point[0]", self.point[0], false)?;
+        param(item, "point[1]", self.point[1], false)?;
+        match self.frame {
+            None => Ok((BodyId::GROUND, self.point)),
+            Some(f) => Ok(frame_point(model, model.frame_id(f)?, self.point)),
+        }
+    }
+}
+
+/// A linear spring–damper between two body points (or a body point and a ground point):
+/// tension `T = preload + k (l − rest) + c l̇` along the line between the points,
+/// pulling them together when positive. When the points coincide the direction is undefined
+/// and the element exerts no force.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointSpringDamper {
+    name: String,
+    a: (BodyId, [f64; 2]),
+    b: (BodyId, [f64; 2]),
+    law: SpringLaw,
+}
+
+impl PointSpringDamper {
+    /// A spring–damper from `a` to `b`; stiffness, damping and rest length must be
+    /// non-negative (the preload is the tension at rest length).
+    pub fn new(
+        model: &Model,
+        name: &str,
+        a: Attachment<'_>,
+        b: Attachment<'_>,
+        law: SpringLaw,
+    ) -> Result<Self> {
+        let item = format!("point spring '{name}'");
+        Ok(Self {
+            a: a.resolve(model, &format!("{item}.a"))?,
+            b: b.resolve(model, &format!("{item}.b"))?,
+            law: law.validated(&item, true)?,
+            name: item,
+        })
+    }
+
+    /// Current length (m), from the poses in `ctx`.
+    pub fn length(&self, ctx: &ForceContext<'_>) -> f64 {
+        let pa = ctx.point_position(self.a.0, self.a.1);
+        let pb = ctx.point_position(self.b.0, self.b.1);
+        (pb[0] - pa[0]).hypot(pb[1] - pa[1])
+    }
+}
+
+impl ForceElement for PointSpringDamper {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
+        let pa = ctx.point_position(self.a.0, self.a.1);
+        let pb = ctx.point_position(self.b.0, self.b.1);
+        let d = [pb[0] - pa[0], pb[1] - pa[1]];
+        let l = d[0].hypot(d[1]);
+        if l.is_nan() || l <= 1e-12 {
+            return;
+        }
+        let u = [d[0] / l, d[1] / l];
+        let va = ctx.point_velocity(self.a.0, self.a.1);
+        let vb = ctx.point_velocity(self.b.0, self.b.1);
+        // l̇ = (v_b − v_a) · u ;  T = preload + k (l − l₀) + c l̇
+        let ldot = (vb[0] - va[0]) * u[0] + (vb[1] - va[1]) * u[1];
+        let law = &self.law;
+        let t = law.preload + law.stiffness * (l - law.rest) + law.damping * ldot;
+        loads.add_force_at_point(self.a.0, pa, [t * u[0], t * u[1]]);
+        loads.add_force_at_point(self.b.0, pb, [-t * u[0], -t * u[1]]);
+    }
+
+    fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
+        let e = self.length(ctx) - self.law.rest;
+        0.5 * self.law.stiffness * e * e + self.law.preload * e
+    }
+}
+
+/// The optional Stribeck part of pivot friction: the breakaway torque `static_torque` decays
+/// to the Coulomb level over the speed scale `velocity` as `exp(−(v / velocity)²)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stribeck {
+    /// Breakaway (static) friction torque, ≥ the Coulomb torque (N·m, or N on a slider).
+    pub static_torque: f64,
+    /// Stribeck velocity (rad/s or m/s), positive.
+    pub velocity: f64,
+}
+
+/// Friction in a pivot (or slider): regularised Coulomb plus viscous, with an optional
+/// Stribeck peak:
+/// `τ = −[(T_c + (T_s − T_c) e^{−(v/v_s)²}) tanh(v / v_ε) + b v]`.
+/// `v_ε` (the regularisation velocity) sets how sharply the friction torque reverses; the
+/// element's switching function is the joint velocity, so an integrator can locate
+/// stick–slip reversals.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PivotFriction {
+    name: String,
+    coordinate: usize,
+    coulomb: f64,
+    viscous: f64,
+    stribeck: Option<Stribeck>,
+    regularization: f64,
+}
+
+impl PivotFriction {
+    /// Friction on the joint named `joint`: Coulomb torque `coulomb` (N·m), viscous
+    /// coefficient `viscous` (N·m·s/rad), regularisation velocity `regularization` (rad/s,
+    /// positive), optional Stribeck peak.
+    pub fn new(
+        model: &Model,
+        joint: &str,
+        coulomb: f64,
+        viscous: f64,
+        regularization: f64,
+        stribeck: Option<Stribeck>,
+    ) -> Result<Self> {
+        let name = format!("pivot friction '{joint}'");
+        let coulomb = param(&name, "coulomb", coulomb, true)?;
+        let regularization = param(&name, "regularization", regularization, true)?;
+        if regularization <= 0.0 {
+            return Err(CoreError::InvalidParameter {
+                item: format!("{name}.regularization"),
+                message: "must be positive".into(),
+            });
+        }
+        if let Some(s) = stribeck {
+            param(&name, "stribeck.static_torque", s.static_torque, true)?;
+            param(&name, "stribeck.velocity", s.velocity, true)?;
+            if s.velocity <= 0.0 || s.static_torque < coulomb {
+                return Err(CoreError::InvalidParameter {
+                    item: format!("{name}.stribeck"),
+                    message: format!(
+                        "needs velocity > 0 and static_torque >= coulomb ({coulomb}), got {s:?}"
+                    ),
+                });
+            }
+        }
+        Ok(Self {
+            coordinate: model.coordinate_id(joint)?,
+            coulomb,
+            viscous: param(&name, "viscous", viscous, true)?,
+            stribeck,
+            regularization,
+            name,
+        })
+    }
+
+    /// Friction torque at joint velocity `v`.
+    pub fn torque(&self, v: f64) -> f64 {
+        let level = match self.stribeck {
+            None => self.coulomb,
+            Some(s) => {
+                let r = v / s.velocity;
+                self.coulomb + (s.static_torque - self.coulomb) * (-r * r).exp()
+            }
+        };
+        -(level * (v / self.regularization).tanh() + self.viscous * v)
+    }
+}
+
+impl ForceElement for PivotFriction {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
+        let k = self.coordinate;
+        loads.add_generalized(k, self.torque(ctx.v[k]));
+    }
+
+    fn switch_count(&self) -> usize {
+        1
+    }
+
+    fn switching_functions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
+        out[0] = ctx.v[self.coordinate];
+    }
+
+    fn switch_direction(&self, _k: usize) -> Crossing {
+        Crossing::Both
+    }
+}
+
+/// The frame in which an applied force's direction is fixed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadFrame {
+    /// The direction stays fixed in the world.
+    World,
+    /// The direction turns with the body.
+    Body,
+}
+
+#[derive(Clone)]
+enum LoadKind {
+    Force {
+        point: [f64; 2],
+        direction: [f64; 2],
+        frame: LoadFrame,
+    },
+    Torque,
+}
+
+/// A force at a body point, or a torque on a body, whose magnitude is a function of time:
+/// `F(t) = magnitude(t) · direction`.
+#[derive(Clone)]
+pub struct AppliedLoad {
+    name: String,
+    body: BodyId,
+    kind: LoadKind,
+    magnitude: Arc<dyn TimeFunction>,
+}
+
+impl std::fmt::Debug for AppliedLoad {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("AppliedLoad")
+            .field("name", &self.name)
+            .field("body", &self.body)
+            .finish_non_exhaustive()
+    }
+}
+
+impl AppliedLoad {
+    /// A force `magnitude(t) · direction` at `point` of the named frame (both in frame
+    /// coordinates when `frame` is [`LoadFrame::Body`]; the direction in world coordinates
+    /// when it is [`LoadFrame::World`]). `direction` is used as given (not normalised).
+    pub fn force(
+        model: &Model,
+        name: &str,
+        at: Attachment<'_>,
+        direction: [f64; 2],
+        frame: LoadFrame,
+        magnitude: impl TimeFunction + 'static,
+    ) -> Result<Self> {
+        let item = format!("applied force '{name}'");
+        let (body, point) = at.resolve(model, &item)?;
+        param(&item, "direction[0]", direction[0], false)?;
+        param(&item, "direction[1]", direction[1], false)?;
+        let direction = match (at.frame, frame) {
+            (Some(f), LoadFrame::Body) => {
+                model.frame(model.frame_id(f)?).placement.rotate(direction)
+            }
+            _ => direction,
+        };
+        Ok(Self {
+            name: item,
+            body,
+            kind: LoadKind::Force {
+                point,
+                direction,
+                frame,
+            },
+            magnitude: Arc::new(magnitude),
+        })
+    }
+
+    /// A torque `magnitude(t)` (N·m, counter-clockwise) on the body carrying the named frame.
+    pub fn torque(
+        model: &Model,
+        name: &str,
+        frame: &str,
+        magnitude: impl TimeFunction + 'static,
+    ) -> Result<Self> {
+        Ok(Self {
+            name: format!("applied torque '{name}'"),
+            body: model.frame(model.frame_id(frame)?).body,
+            kind: LoadKind::Torque,
+            magnitude: Arc::new(magnitude),
+        })
+    }
+}
+
+impl ForceElement for AppliedLoad {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
+        let m = self.magnitude.value(ctx.t);
+        match self.kind {
+            LoadKind::Torque => loads.add_torque(self.body, m),
+            LoadKind::Force {
+                point,
+                direction,
+                frame,
+            } => {
+                let pose = ctx.body_pose(self.body);
+                let dir = match frame {
+                    LoadFrame::World => direction,
+                    LoadFrame::Body => pose.rotate(direction),
+                };
+                let p = pose.transform_point(point);
+                loads.add_force_at_point(self.body, p, [m * dir[0], m * dir[1]]);
+            }
+        }
+    }
+}

@@ -1,0 +1,129 @@
+//! The [`ForceElement`] trait through which springs, friction, contacts and inputs add
+//! generalized forces to a [`crate::System`].
+
+use crate::data::Data;
+use crate::kinematics;
+use crate::model::{BodyId, Model};
+use crate::spatial::{Force, Transform};
+
+/// What a force element sees when it is evaluated: the model, the kinematics of the current
+/// state (world poses and body velocities are up to date), time, coordinates and the
+/// element's own internal states.
+pub struct ForceContext<'a> {
+    /// The model.
+    pub model: &'a Model,
+    /// Workspace with poses and velocities of the current `(q, v)`.
+    pub data: &'a Data,
+    /// Time (s).
+    pub t: f64,
+    /// Generalized coordinates (prescribed ones already set from their drives).
+    pub q: &'a [f64],
+    /// Generalized velocities.
+    pub v: &'a [f64],
+    /// This element's internal states (empty when it has none).
+    pub states: &'a [f64],
+}
+
+impl ForceContext<'_> {
+    /// World position of a point fixed to `body` (coordinates in its joint frame).
+    pub fn point_position(&self, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
+        kinematics::point_position(self.data, body, p_b)
+    }
+
+    /// World velocity of a point fixed to `body`.
+    pub fn point_velocity(&self, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
+        kinematics::point_velocity(self.data, body, p_b)
+    }
+
+    /// World pose of a body's joint frame.
+    pub fn body_pose(&self, body: BodyId) -> Transform {
+        self.data.body_pose(body)
+    }
+
+    /// Angular velocity of a body (rad/s).
+    pub fn angular_velocity(&self, body: BodyId) -> f64 {
+        self.data.body_velocity(body).w
+    }
+}
+
+/// Where force elements put their loads: generalized forces by coordinate, and forces and
+/// torques on bodies in world coordinates. Loads on the ground are accepted and ignored.
+pub struct Loads<'a> {
+    pub(crate) tau: &'a mut [f64],
+    /// World spatial force on each body, about the world origin.
+    pub(crate) body_forces: &'a mut [Force],
+}
+
+impl Loads<'_> {
+    /// Adds `value` to the generalized force of coordinate `k`.
+    #[inline]
+    pub fn add_generalized(&mut self, k: usize, value: f64) {
+        self.tau[k] += value;
+    }
+
+    /// Adds a force `f_w` (world coordinates) applied at the world point `p_w` to `body`.
+    #[inline]
+    pub fn add_force_at_point(&mut self, body: BodyId, p_w: [f64; 2], f_w: [f64; 2]) {
+        self.body_forces[body.index()] += Force::at_point(p_w, f_w);
+    }
+
+    /// Adds a pure torque (N·m, about z) to `body`.
+    #[inline]
+    pub fn add_torque(&mut self, body: BodyId, torque: f64) {
+        self.body_forces[body.index()].n += torque;
+    }
+}
+
+/// Direction in which a switching function's zero crossing counts as an event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    /// From negative to positive.
+    Rising,
+    /// From positive to negative.
+    Falling,
+    /// Either way.
+    Both,
+}
+
+/// A source of generalized forces: a spring, friction, a contact, an input. Elements are
+/// immutable during a simulation; anything that evolves (felt memory, friction state) is an
+/// internal state integrated with the system, whose rate the element writes.
+///
+/// Implementations must not allocate in [`ForceElement::apply`].
+pub trait ForceElement: Send + Sync {
+    /// A name for messages and output.
+    fn name(&self) -> &str;
+
+    /// Number of internal states.
+    fn state_count(&self) -> usize {
+        0
+    }
+
+    /// Initial values of the internal states (zero by default).
+    fn initial_states(&self, _model: &Model, out: &mut [f64]) {
+        out.fill(0.0);
+    }
+
+    /// Adds this element's loads for the state in `ctx`, and writes the rates of its
+    /// internal states into `state_rates` (length [`ForceElement::state_count`]).
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, state_rates: &mut [f64]);
+
+    /// Stored (potential) energy of the element, for energy balances (J); zero by default.
+    fn potential_energy(&self, _ctx: &ForceContext<'_>) -> f64 {
+        0.0
+    }
+
+    /// Number of switching functions (for event location by integrators).
+    fn switch_count(&self) -> usize {
+        0
+    }
+
+    /// Values of the switching functions (length [`ForceElement::switch_count`]); an event
+    /// happens where one crosses zero.
+    fn switching_functions(&self, _ctx: &ForceContext<'_>, _out: &mut [f64]) {}
+
+    /// Which crossings of switching function `k` are events.
+    fn switch_direction(&self, _k: usize) -> Crossing {
+        Crossing::Both
+    }
+}

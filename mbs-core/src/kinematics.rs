@@ -1,0 +1,116 @@
+//! Forward kinematics: body poses, velocities and accelerations, and the position, velocity
+//! and acceleration of body-fixed points.
+
+use crate::data::Data;
+use crate::error::{Result, check_input};
+use crate::model::{BodyId, Model};
+use crate::spatial::{Motion, Transform};
+
+/// Computes the world pose of every body for configuration `q`.
+pub fn update_poses(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
+    check_input("q", q, model.nv())?;
+    poses_pass(model, data, q);
+    Ok(())
+}
+
+/// Computes world poses and body velocities for `(q, v)`.
+pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> Result<()> {
+    check_input("q", q, model.nv())?;
+    check_input("v", v, model.nv())?;
+    kinematics_pass(model, data, q, v);
+    Ok(())
+}
+
+/// Computes world poses, body velocities and body accelerations (gravity excluded) for
+/// `(q, v, a)`.
+pub fn forward_kinematics_acc(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    a: &[f64],
+) -> Result<()> {
+    check_input("a", a, model.nv())?;
+    forward_kinematics(model, data, q, v)?;
+    data.a[0] = Motion::ZERO;
+    for i in 1..model.bodies.len() {
+        let b = &model.bodies[i];
+        let iv = b.idx_v;
+        let vj = b.s * v[iv];
+        // a_i = X a_λ + S q̈ + v_i ×ₘ S q̇
+        data.a[i] = data.x_up[i].apply_motion(&data.a[b.parent])
+            + b.s * a[iv]
+            + data.v[i].cross_motion(&vj);
+    }
+    Ok(())
+}
+
+/// Joint transforms and world poses.
+pub(crate) fn poses_pass(model: &Model, data: &mut Data, q: &[f64]) {
+    data.x_world[0] = Transform::IDENTITY;
+    for i in 1..model.bodies.len() {
+        let b = &model.bodies[i];
+        let x = b.joint_transform(q[b.idx_v]);
+        data.x_up[i] = x;
+        data.x_world[i] = data.x_world[b.parent].compose(&x);
+    }
+}
+
+/// Joint transforms, world poses and body velocities (inputs already checked).
+pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+    data.x_world[0] = Transform::IDENTITY;
+    data.v[0] = Motion::ZERO;
+    for i in 1..model.bodies.len() {
+        let b = &model.bodies[i];
+        let x = b.joint_transform(q[b.idx_v]);
+        data.x_up[i] = x;
+        data.x_world[i] = data.x_world[b.parent].compose(&x);
+        // v_i = X v_λ + S q̇
+        data.v[i] = x.apply_motion(&data.v[b.parent]) + b.s * v[b.idx_v];
+    }
+}
+
+/// World position of the point `p_b` fixed to `body` (coordinates in the body's joint frame).
+/// Needs poses from [`forward_kinematics`] or [`update_poses`].
+pub fn point_position(data: &Data, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
+    data.x_world[body.0].transform_point(p_b)
+}
+
+/// World velocity of the point `p_b` fixed to `body`: `R (v + ω × p)`. Needs
+/// [`forward_kinematics`].
+pub fn point_velocity(data: &Data, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
+    let v = &data.v[body.0];
+    data.x_world[body.0].rotate([v.vx - v.w * p_b[1], v.vy + v.w * p_b[0]])
+}
+
+/// World (classical) acceleration of the point `p_b` fixed to `body`, gravity excluded:
+/// `R (a + α × p + ω × (v + ω × p))`, with `(α, a)` the spatial acceleration. Needs
+/// [`forward_kinematics_acc`].
+pub fn point_acceleration(data: &Data, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
+    let v = &data.v[body.0];
+    let a = &data.a[body.0];
+    let vp = [v.vx - v.w * p_b[1], v.vy + v.w * p_b[0]];
+    let acc = [
+        a.vx - a.w * p_b[1] - v.w * vp[1],
+        a.vy + a.w * p_b[0] + v.w * vp[0],
+    ];
+    data.x_world[body.0].rotate(acc)
+}
+
+/// Angular velocity (rad/s) of a body. Needs [`forward_kinematics`].
+pub fn angular_velocity(data: &Data, body: BodyId) -> f64 {
+    data.v[body.0].w
+}
+
+/// World pose of a named frame. Needs poses.
+pub fn frame_pose(model: &Model, data: &Data, frame: crate::FrameId) -> Transform {
+    let f = model.frame(frame);
+    data.x_world[f.body.0].compose(&f.placement)
+}
+
+/// The body carrying a named frame, and the point `p_f` (given in the frame) expressed in
+/// that body's joint frame: the form every point query takes.
+pub fn frame_point(model: &Model, frame: crate::FrameId, p_f: [f64; 2]) -> (BodyId, [f64; 2]) {
+    let f = model.frame(frame);
+    (f.body, f.placement.transform_point(p_f))
+}

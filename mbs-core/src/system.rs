@@ -1,0 +1,478 @@
+//! [`System`]: a model plus force elements and prescribed coordinates, giving the state
+//! derivative of `x = [q, v, internal states]`.
+
+use std::sync::Arc;
+
+use crate::aba::{Prescribed, articulated_pass};
+use crate::data::Data;
+use crate::energy::{kinetic_energy_from_kinematics, potential_energy_from_poses};
+use crate::error::{CoreError, Result};
+use crate::force::{Crossing, ForceContext, ForceElement, Loads};
+use crate::kinematics::kinematics_pass;
+use crate::model::Model;
+use crate::spatial::Force;
+use crate::time_function::{Drive, DriveState};
+
+/// A model with its force elements and prescribed (driven) coordinates. The state is
+/// `x = [q (nv), v (nv), internal states of the elements in order]`; [`System::derivative`]
+/// gives `ẋ = [v, q̈, state rates]` with `q̈` from the articulated-body algorithm (hybrid
+/// dynamics when coordinates are prescribed).
+///
+/// A `System` is immutable once built and cheap to clone (elements are shared); each thread
+/// evaluating it needs its own [`Workspace`].
+///
+/// ```
+/// use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System};
+/// use mbs_core::elements::{JointSpringDamper, SpringLaw};
+/// let mut b = ModelBuilder::new();
+/// b.add_link("arm", None, JointKind::Revolute, Placement::default(),
+///            BodySpec::new(1.0, [0.0, 0.0], 0.5));
+/// let model = b.build().unwrap();
+/// let spring = JointSpringDamper::new(&model, "arm", SpringLaw::new(2.0, 0.0)).unwrap();
+/// let mut system = System::new(model);
+/// system.add_element(spring);
+/// let mut ws = system.workspace();
+/// let x = [0.1, 0.0];
+/// let mut xdot = [0.0; 2];
+/// system.derivative(&mut ws, 0.0, &x, &mut xdot).unwrap();
+/// // θ̈ = −k θ / I = −2 · 0.1 / 0.5
+/// assert!((xdot[1] + 0.4).abs() < 1e-12);
+/// ```
+#[derive(Clone)]
+pub struct System {
+    model: Model,
+    elements: Vec<Arc<dyn ForceElement>>,
+    /// Start of each element's internal states in x.
+    state_offsets: Vec<usize>,
+    /// Start of each element's switching functions.
+    switch_offsets: Vec<usize>,
+    state_len: usize,
+    switch_len: usize,
+    drives: Vec<Option<Arc<dyn Drive>>>,
+    mask: Vec<bool>,
+}
+
+/// Per-thread scratch space for evaluating a [`System`]: allocated once by
+/// [`System::workspace`], reused by every evaluation.
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    data: Data,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    tau: Vec<f64>,
+    qdd_prescribed: Vec<f64>,
+    forces_world: Vec<Force>,
+    forces_local: Vec<Force>,
+    scratch_tau: Vec<f64>,
+    scratch_forces: Vec<Force>,
+}
+
+impl Workspace {
+    /// The dynamics workspace, holding poses, velocities, `qdd` and `tau` of the last
+    /// evaluation.
+    pub fn data(&self) -> &Data {
+        &self.data
+    }
+
+    /// Generalized forces of the last evaluation: for prescribed coordinates the force the
+    /// drive supplied, for free coordinates the sum of the force elements' contributions.
+    pub fn generalized_forces(&self) -> &[f64] {
+        self.data.tau.as_slice()
+    }
+
+    /// The coordinates used in the last evaluation (prescribed ones from their drives).
+    pub fn q(&self) -> &[f64] {
+        &self.q
+    }
+
+    /// The velocities used in the last evaluation (prescribed ones from their drives).
+    pub fn v(&self) -> &[f64] {
+        &self.v
+    }
+}
+
+/// The energy of a system state, split by origin (J).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energy {
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Gravitational potential energy.
+    pub gravity: f64,
+    /// Energy stored in force elements (springs).
+    pub elastic: f64,
+}
+
+impl Energy {
+    /// The sum.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.gravity + self.elastic
+    }
+}
+
+impl System {
+    /// A system with no force elements and no prescribed coordinate.
+    pub fn new(model: Model) -> Self {
+        let nv = model.nv();
+        Self {
+            state_len: 2 * nv,
+            switch_len: 0,
+            model,
+            elements: Vec::new(),
+            state_offsets: Vec::new(),
+            switch_offsets: Vec::new(),
+            drives: vec![None; nv],
+            mask: vec![false; nv],
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// Adds a force element; returns its index.
+    pub fn add_element(&mut self, element: impl ForceElement + 'static) -> usize {
+        self.add_shared_element(Arc::new(element))
+    }
+
+    /// Adds a shared force element; returns its index.
+    pub fn add_shared_element(&mut self, element: Arc<dyn ForceElement>) -> usize {
+        self.state_offsets.push(self.state_len);
+        self.switch_offsets.push(self.switch_len);
+        self.state_len += element.state_count();
+        self.switch_len += element.switch_count();
+        self.elements.push(element);
+        self.elements.len() - 1
+    }
+
+    /// The force elements, in order.
+    pub fn elements(&self) -> &[Arc<dyn ForceElement>] {
+        &self.elements
+    }
+
+    /// Makes the joint named `joint` follow `drive`: its coordinate and velocity are taken
+    /// from the drive (whatever the state holds) and the force needed is reported by
+    /// [`Workspace::generalized_forces`].
+    pub fn prescribe(&mut self, joint: &str, drive: impl Drive + 'static) -> Result<()> {
+        let k = self.model.coordinate_id(joint)?;
+        self.drives[k] = Some(Arc::new(drive));
+        self.mask[k] = true;
+        Ok(())
+    }
+
+    /// Removes the drive of a joint, making it free again.
+    pub fn release(&mut self, joint: &str) -> Result<()> {
+        let k = self.model.coordinate_id(joint)?;
+        self.drives[k] = None;
+        self.mask[k] = false;
+        Ok(())
+    }
+
+    /// Whether each coordinate is prescribed.
+    pub fn prescribed_mask(&self) -> &[bool] {
+        &self.mask
+    }
+
+    /// Length of the state vector.
+    pub fn state_len(&self) -> usize {
+        self.state_len
+    }
+
+    /// Number of switching functions over all elements.
+    pub fn switch_len(&self) -> usize {
+        self.switch_len
+    }
+
+    /// Range of element `e`'s internal states in the state vector.
+    pub fn element_state_range(&self, e: usize) -> std::ops::Range<usize> {
+        let start = self.state_offsets[e];
+        start..start + self.elements[e].state_count()
+    }
+
+    /// The element and local index of switching function `k`, and its crossing direction.
+    pub fn switch_info(&self, k: usize) -> Option<(usize, usize, Crossing)> {
+        let e = self
+            .switch_offsets
+            .partition_point(|&o| o <= k)
+            .checked_sub(1)?;
+        let local = k - self.switch_offsets[e];
+        (local < self.elements[e].switch_count())
+            .then(|| (e, local, self.elements[e].switch_direction(local)))
+    }
+
+    /// A workspace for evaluating this system.
+    pub fn workspace(&self) -> Workspace {
+        let nv = self.model.nv();
+        let nb = self.model.nbodies();
+        Workspace {
+            data: Data::new(&self.model),
+            q: vec![0.0; nv],
+            v: vec![0.0; nv],
+            tau: vec![0.0; nv],
+            qdd_prescribed: vec![0.0; nv],
+            forces_world: vec![Force::ZERO; nb],
+            forces_local: vec![Force::ZERO; nb],
+            scratch_tau: vec![0.0; nv],
+            scratch_forces: vec![Force::ZERO; nb],
+        }
+    }
+
+    /// The initial state for coordinates `q0` and velocities `v0` at time `t0`: prescribed
+    /// coordinates take their drive's values, internal states their elements' initial
+    /// values.
+    pub fn initial_state(&self, t0: f64, q0: &[f64], v0: &[f64]) -> Result<Vec<f64>> {
+        let nv = self.model.nv();
+        crate::error::check_input("q0", q0, nv)?;
+        crate::error::check_input("v0", v0, nv)?;
+        let mut x = vec![0.0; self.state_len];
+        x[..nv].copy_from_slice(q0);
+        x[nv..2 * nv].copy_from_slice(v0);
+        for (k, d) in self.drives.iter().enumerate() {
+            if let Some(d) = d {
+                let s = self.eval_drive(d.as_ref(), k, t0)?;
+                x[k] = s.q;
+                x[nv + k] = s.v;
+            }
+        }
+        for (e, el) in self.elements.iter().enumerate() {
+            let r = self.element_state_range(e);
+            el.initial_states(&self.model, &mut x[r]);
+        }
+        Ok(x)
+    }
+
+    fn eval_drive(&self, d: &dyn Drive, k: usize, t: f64) -> Result<DriveState> {
+        let s = d.eval(t);
+        if s.q.is_finite() && s.v.is_finite() && s.a.is_finite() {
+            Ok(s)
+        } else {
+            Err(CoreError::NonFiniteOutput {
+                t,
+                source_name: format!("drive of joint '{}'", self.model.joint_names[k]),
+                quantity: "motion",
+            })
+        }
+    }
+
+    /// What entry `index` of the state vector is, for messages.
+    pub fn state_meaning(&self, index: usize) -> String {
+        let nv = self.model.nv();
+        if index < nv {
+            format!("q of joint '{}'", self.model.joint_names[index])
+        } else if index < 2 * nv {
+            format!("v of joint '{}'", self.model.joint_names[index - nv])
+        } else {
+            let e = self.state_offsets.partition_point(|&o| o <= index) - 1;
+            format!(
+                "internal state {} of {}",
+                index - self.state_offsets[e],
+                self.elements[e].name()
+            )
+        }
+    }
+
+    fn check_state(&self, t: f64, x: &[f64]) -> Result<()> {
+        crate::error::check_input("x", x, self.state_len).map_err(|e| match e {
+            CoreError::NonFiniteInput { index, value, .. } => CoreError::NonFiniteState {
+                t,
+                index,
+                meaning: self.state_meaning(index),
+                value,
+            },
+            other => other,
+        })
+    }
+
+    /// Loads q, v (drives applied) and runs kinematics.
+    fn prepare(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<()> {
+        self.check_state(t, x)?;
+        let nv = self.model.nv();
+        ws.q.copy_from_slice(&x[..nv]);
+        ws.v.copy_from_slice(&x[nv..2 * nv]);
+        for (k, d) in self.drives.iter().enumerate() {
+            if let Some(d) = d {
+                let s = self.eval_drive(d.as_ref(), k, t)?;
+                ws.q[k] = s.q;
+                ws.v[k] = s.v;
+                ws.qdd_prescribed[k] = s.a;
+            }
+        }
+        kinematics_pass(&self.model, &mut ws.data, &ws.q, &ws.v);
+        Ok(())
+    }
+
+    /// The state derivative `ẋ = f(t, x)`, written into `xdot`. Allocates nothing.
+    ///
+    /// Errors: wrong lengths, a non-finite state (named), a drive or element producing a
+    /// non-finite value (named).
+    pub fn derivative(
+        &self,
+        ws: &mut Workspace,
+        t: f64,
+        x: &[f64],
+        xdot: &mut [f64],
+    ) -> Result<()> {
+        if xdot.len() != self.state_len {
+            return Err(CoreError::DimensionMismatch {
+                what: "xdot",
+                expected: self.state_len,
+                got: xdot.len(),
+            });
+        }
+        self.prepare(ws, t, x)?;
+        let nv = self.model.nv();
+        ws.tau.fill(0.0);
+        ws.forces_world.fill(Force::ZERO);
+        let (head, rates) = xdot.split_at_mut(2 * nv);
+        for (e, el) in self.elements.iter().enumerate() {
+            let r = self.element_state_range(e);
+            let ctx = ForceContext {
+                model: &self.model,
+                data: &ws.data,
+                t,
+                q: &ws.q,
+                v: &ws.v,
+                states: &x[r.clone()],
+            };
+            let mut loads = Loads {
+                tau: &mut ws.tau,
+                body_forces: &mut ws.forces_world,
+            };
+            el.apply(
+                &ctx,
+                &mut loads,
+                &mut rates[r.start - 2 * nv..r.end - 2 * nv],
+            );
+        }
+        let loads_finite = ws.tau.iter().all(|v| v.is_finite())
+            && ws.forces_world.iter().all(Force::is_finite)
+            && rates.iter().all(|v| v.is_finite());
+        if !loads_finite {
+            return Err(self.find_bad_element(ws, t, x));
+        }
+        // World forces about the world origin → body frames.
+        for i in 1..self.model.nbodies() {
+            ws.forces_local[i] = ws.data.x_world[i].apply_force(&ws.forces_world[i]);
+        }
+        let prescribed = self.mask.iter().any(|&m| m).then_some(Prescribed {
+            mask: &self.mask,
+            qdd: &ws.qdd_prescribed,
+        });
+        articulated_pass(
+            &self.model,
+            &mut ws.data,
+            &ws.v,
+            &ws.tau,
+            Some(&ws.forces_local),
+            prescribed,
+        );
+        if prescribed.is_none() {
+            ws.data.tau.as_mut_slice().copy_from_slice(&ws.tau);
+        }
+        head[..nv].copy_from_slice(&ws.v);
+        head[nv..].copy_from_slice(ws.data.qdd.as_slice());
+        if let Some(k) = head[nv..].iter().position(|a| !a.is_finite()) {
+            return Err(CoreError::NonFiniteOutput {
+                t,
+                source_name: format!("dynamics of joint '{}'", self.model.joint_names[k]),
+                quantity: "acceleration",
+            });
+        }
+        Ok(())
+    }
+
+    /// Re-evaluates the elements one at a time to name the one producing non-finite loads
+    /// (cold path: only after a failure).
+    fn find_bad_element(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> CoreError {
+        for (e, el) in self.elements.iter().enumerate() {
+            let r = self.element_state_range(e);
+            ws.scratch_tau.fill(0.0);
+            ws.scratch_forces.fill(Force::ZERO);
+            let ctx = ForceContext {
+                model: &self.model,
+                data: &ws.data,
+                t,
+                q: &ws.q,
+                v: &ws.v,
+                states: &x[r.clone()],
+            };
+            let mut loads = Loads {
+                tau: &mut ws.scratch_tau,
+                body_forces: &mut ws.scratch_forces,
+            };
+            let mut rates = vec![0.0; r.len()];
+            el.apply(&ctx, &mut loads, &mut rates);
+            let bad = ws.scratch_tau.iter().any(|v| !v.is_finite())
+                || ws.scratch_forces.iter().any(|f| !f.is_finite())
+                || rates.iter().any(|v| !v.is_finite());
+            if bad {
+                return CoreError::NonFiniteOutput {
+                    t,
+                    source_name: el.name().to_string(),
+                    quantity: "load or state rate",
+                };
+            }
+        }
+        CoreError::NonFiniteOutput {
+            t,
+            source_name: "force elements".into(),
+            quantity: "load or state rate",
+        }
+    }
+
+    /// Values of all switching functions at `(t, x)`, written into `out` (length
+    /// [`System::switch_len`]).
+    pub fn switching_functions(
+        &self,
+        ws: &mut Workspace,
+        t: f64,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<()> {
+        if out.len() != self.switch_len {
+            return Err(CoreError::DimensionMismatch {
+                what: "switching function output",
+                expected: self.switch_len,
+                got: out.len(),
+            });
+        }
+        self.prepare(ws, t, x)?;
+        for (e, el) in self.elements.iter().enumerate() {
+            let r = self.element_state_range(e);
+            let ctx = ForceContext {
+                model: &self.model,
+                data: &ws.data,
+                t,
+                q: &ws.q,
+                v: &ws.v,
+                states: &x[r],
+            };
+            let start = self.switch_offsets[e];
+            el.switching_functions(&ctx, &mut out[start..start + el.switch_count()]);
+        }
+        Ok(())
+    }
+
+    /// The energy of state `x` at time `t`: kinetic, gravitational and stored in elements.
+    pub fn energy(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<Energy> {
+        self.prepare(ws, t, x)?;
+        let mut elastic = 0.0;
+        for (e, el) in self.elements.iter().enumerate() {
+            let r = self.element_state_range(e);
+            let ctx = ForceContext {
+                model: &self.model,
+                data: &ws.data,
+                t,
+                q: &ws.q,
+                v: &ws.v,
+                states: &x[r],
+            };
+            elastic += el.potential_energy(&ctx);
+        }
+        Ok(Energy {
+            kinetic: kinetic_energy_from_kinematics(&self.model, &ws.data),
+            gravity: potential_energy_from_poses(&self.model, &ws.data),
+            elastic,
+        })
+    }
+}
