@@ -176,10 +176,10 @@ pub(crate) fn check_input(what: &'static str, x: &[f64], n: usize) -> Result<()>
     }
     // Summing is branch-free; a NaN or ±inf anywhere makes the sum non-finite.
     let sum: f64 = x.iter().map(|v| v * 0.0).sum();
-    if sum != 0.0 {
-        if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(CoreError::NonFiniteInput { what, index, value });
-        }
+    if sum != 0.0
+        && let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite())
+    {
+        return Err(CoreError::NonFiniteInput { what, index, value });
     }
     Ok(())
 }
