@@ -86,9 +86,19 @@ pub struct JointDescription {
 }
 
 impl ModelDescription {
-    /// Parses a JSON description; the error says where (line, column) and what is wrong.
+    /// Parses a JSON description; the error names the field (as a path such as
+    /// `joints[2].body.mass`), where it is (line, column) and what is wrong.
     pub fn from_json_str(text: &str) -> Result<Self> {
-        serde_json::from_str(text).map_err(|e| CoreError::Parse(e.to_string()))
+        let de = &mut serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            if path.is_empty() || path == "." {
+                CoreError::Parse(inner.to_string())
+            } else {
+                CoreError::Parse(format!("field `{path}`: {inner}"))
+            }
+        })
     }
 
     /// Serialises to pretty JSON.

@@ -49,6 +49,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod aba;
+pub mod benchmarks;
 mod builder;
 mod crba;
 mod data;

@@ -163,11 +163,12 @@ impl Model {
     /// The body with this name (a moving body; the name of a body merged by a fixed joint
     /// is a frame, see [`Model::frame_id`]).
     pub fn body_id(&self, name: &str) -> Result<BodyId> {
-        self.body_names
+        // Index 0 is the ground's placeholder name: search the moving bodies only, so a
+        // body the user named "ground" is still found.
+        self.body_names[1..]
             .iter()
             .position(|n| n == name)
-            .filter(|&i| i > 0)
-            .map(BodyId)
+            .map(|i| BodyId(i + 1))
             .ok_or_else(|| CoreError::UnknownName {
                 what: "moving body",
                 name: name.to_string(),
