@@ -72,7 +72,8 @@ pub struct Prescribed<'a> {
 /// `prescribed.qdd[k]`; the others are free under the generalized forces `tau[k]` (entries of
 /// `tau` at prescribed coordinates are ignored). Afterwards `data.qdd()` holds every
 /// acceleration and `data.tau()` every generalized force: the given ones for free
-/// coordinates and, for prescribed coordinates, the force the drive must supply.
+/// coordinates and, for prescribed coordinates, the whole generalized force the joint must
+/// transmit (`f_ext`, if any, acts in addition).
 ///
 /// With no coordinate prescribed it is [`aba`] (plus the output of `tau`); with all
 /// prescribed it is inverse dynamics.

@@ -162,3 +162,25 @@ pub(crate) fn rnea_pass(
         }
     }
 }
+
+/// Generalized forces `Σ Jᵀ f` of body forces `f_local` (body frames), using the joint
+/// transforms in `data.x_up`: a backward pass accumulating subtree forces. `acc` is
+/// scratch of length nbodies.
+pub(crate) fn body_forces_to_generalized(
+    model: &Model,
+    data: &Data,
+    f_local: &[Force],
+    acc: &mut [Force],
+    out: &mut [f64],
+) {
+    let bodies = &model.bodies;
+    acc.copy_from_slice(f_local);
+    for i in (1..bodies.len()).rev() {
+        let b = &bodies[i];
+        out[b.idx_v] = b.s.dot(&acc[i]);
+        if b.parent > 0 {
+            let fp = data.x_up[i].apply_force_transpose(&acc[i]);
+            acc[b.parent] += fp;
+        }
+    }
+}

@@ -10,6 +10,7 @@ use crate::error::{CoreError, Result};
 use crate::force::{Crossing, ForceContext, ForceElement, Loads};
 use crate::kinematics::kinematics_pass;
 use crate::model::Model;
+use crate::rnea::body_forces_to_generalized;
 use crate::spatial::Force;
 use crate::time_function::{Drive, DriveState};
 
@@ -63,6 +64,8 @@ pub struct Workspace {
     qdd_prescribed: Vec<f64>,
     forces_world: Vec<Force>,
     forces_local: Vec<Force>,
+    element_tau: Vec<f64>,
+    drive_tau: Vec<f64>,
     scratch_tau: Vec<f64>,
     scratch_forces: Vec<Force>,
 }
@@ -74,10 +77,16 @@ impl Workspace {
         &self.data
     }
 
-    /// Generalized forces of the last evaluation: for prescribed coordinates the force the
-    /// drive supplied, for free coordinates the sum of the force elements' contributions.
-    pub fn generalized_forces(&self) -> &[f64] {
-        self.data.tau.as_slice()
+    /// Total generalized force of the force elements in the last evaluation, per
+    /// coordinate (forces on bodies mapped through the Jacobians: `τ + Σ Jᵀ f`).
+    pub fn element_forces(&self) -> &[f64] {
+        &self.element_tau
+    }
+
+    /// Generalized force each drive supplied in the last evaluation to make its coordinate
+    /// follow the prescribed motion (zero for free coordinates).
+    pub fn drive_forces(&self) -> &[f64] {
+        &self.drive_tau
     }
 
     /// The coordinates used in the last evaluation (prescribed ones from their drives).
@@ -152,7 +161,7 @@ impl System {
 
     /// Makes the joint named `joint` follow `drive`: its coordinate and velocity are taken
     /// from the drive (whatever the state holds) and the force needed is reported by
-    /// [`Workspace::generalized_forces`].
+    /// [`Workspace::drive_forces`].
     pub fn prescribe(&mut self, joint: &str, drive: impl Drive + 'static) -> Result<()> {
         let k = self.model.coordinate_id(joint)?;
         self.drives[k] = Some(Arc::new(drive));
@@ -212,6 +221,8 @@ impl System {
             qdd_prescribed: vec![0.0; nv],
             forces_world: vec![Force::ZERO; nb],
             forces_local: vec![Force::ZERO; nb],
+            element_tau: vec![0.0; nv],
+            drive_tau: vec![0.0; nv],
             scratch_tau: vec![0.0; nv],
             scratch_forces: vec![Force::ZERO; nb],
         }
@@ -366,8 +377,21 @@ impl System {
             Some(&ws.forces_local),
             prescribed,
         );
-        if prescribed.is_none() {
-            ws.data.tau.as_mut_slice().copy_from_slice(&ws.tau);
+        // Element totals τ + Σ Jᵀ f, and what the drives had to add.
+        body_forces_to_generalized(
+            &self.model,
+            &ws.data,
+            &ws.forces_local,
+            &mut ws.scratch_forces,
+            &mut ws.element_tau,
+        );
+        for k in 0..nv {
+            ws.element_tau[k] += ws.tau[k];
+            ws.drive_tau[k] = if self.mask[k] {
+                ws.data.tau[k] - ws.tau[k]
+            } else {
+                0.0
+            };
         }
         head[..nv].copy_from_slice(&ws.v);
         head[nv..].copy_from_slice(ws.data.qdd.as_slice());

@@ -1,0 +1,174 @@
+//! Evaluating the dynamics allocates nothing: a counting global allocator (per thread, so
+//! tests running in parallel do not disturb each other) must see zero allocations during
+//! every algorithm and during `System::derivative` with every kind of force element.
+
+use std::alloc::{GlobalAlloc, Layout, System as SystemAlloc};
+use std::cell::Cell;
+
+use mbs_core::benchmarks::{branching_tree, planar_chain};
+use mbs_core::elements::{
+    AppliedLoad, Attachment, JointSpringDamper, LoadFrame, PivotFriction, PointSpringDamper,
+    SpringLaw, Stribeck,
+};
+use mbs_core::time_function::{PiecewiseLinear, SmoothMove};
+use mbs_core::{
+    Data, Force, Prescribed, System, aba, aba_with_forces, crba, forward_dynamics_crba,
+    forward_kinematics_acc, frame_jacobian, gravity_torque, hybrid_dynamics, kinetic_energy,
+    mechanical_energy, nonlinear_effects, point_jacobian, potential_energy, rnea, rnea_with_forces,
+};
+use nalgebra::DMatrix;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { SystemAlloc.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { SystemAlloc.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { SystemAlloc.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made on this thread while running `f`.
+fn allocations_in(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.with(Cell::get);
+    f();
+    ALLOCATIONS.with(Cell::get) - before
+}
+
+#[test]
+fn the_counter_sees_allocations() {
+    // Guard against a counter that cannot fail.
+    let n = allocations_in(|| {
+        let v = std::hint::black_box(vec![1.0f64; 16]);
+        drop(v);
+    });
+    assert!(n >= 1);
+}
+
+#[test]
+fn algorithms_do_not_allocate() {
+    for model in [planar_chain(5), branching_tree()] {
+        let n = model.nv();
+        let mut data = Data::new(&model);
+        let q: Vec<f64> = (0..n).map(|i| 0.3 * i as f64 - 1.0).collect();
+        let v: Vec<f64> = (0..n).map(|i| 0.1 * i as f64).collect();
+        let a: Vec<f64> = (0..n).map(|i| 1.0 - 0.2 * i as f64).collect();
+        let fext = vec![Force::new(0.1, -0.2, 0.3); model.nbodies()];
+        let mask: Vec<bool> = (0..n).map(|i| i % 2 == 0).collect();
+        let mut jac2 = DMatrix::zeros(2, n);
+        let mut jac3 = DMatrix::zeros(3, n);
+        let body = model.moving_bodies().last().unwrap();
+        let count = allocations_in(|| {
+            rnea(&model, &mut data, &q, &v, &a).unwrap();
+            rnea_with_forces(&model, &mut data, &q, &v, &a, &fext).unwrap();
+            nonlinear_effects(&model, &mut data, &q, &v).unwrap();
+            gravity_torque(&model, &mut data, &q).unwrap();
+            crba(&model, &mut data, &q).unwrap();
+            aba(&model, &mut data, &q, &v, &a).unwrap();
+            aba_with_forces(&model, &mut data, &q, &v, &a, &fext).unwrap();
+            forward_dynamics_crba(&model, &mut data, &q, &v, &a, Some(&fext)).unwrap();
+            hybrid_dynamics(
+                &model,
+                &mut data,
+                &q,
+                &v,
+                &a,
+                Prescribed {
+                    mask: &mask,
+                    qdd: &a,
+                },
+                Some(&fext),
+            )
+            .unwrap();
+            kinetic_energy(&model, &mut data, &q, &v).unwrap();
+            potential_energy(&model, &mut data, &q).unwrap();
+            mechanical_energy(&model, &mut data, &q, &v).unwrap();
+            forward_kinematics_acc(&model, &mut data, &q, &v, &a).unwrap();
+            point_jacobian(&model, &data, body, [0.1, 0.2], &mut jac2).unwrap();
+            frame_jacobian(&model, &data, body, [0.1, 0.2], &mut jac3).unwrap();
+        });
+        assert_eq!(count, 0, "the algorithms allocated {count} times");
+    }
+}
+
+#[test]
+fn system_derivative_does_not_allocate() {
+    let model = branching_tree();
+    let mut system = System::new(model.clone());
+    system.add_element(
+        JointSpringDamper::new(
+            &model,
+            "branch1",
+            SpringLaw::new(3.0, 0.1).with_damping(0.2).with_preload(0.5),
+        )
+        .unwrap(),
+    );
+    system.add_element(
+        PointSpringDamper::new(
+            &model,
+            "tether",
+            Attachment::on("twig02", [0.1, 0.0]),
+            Attachment::ground([1.0, 1.0]),
+            SpringLaw::new(50.0, 0.3).with_damping(1.0),
+        )
+        .unwrap(),
+    );
+    system.add_element(
+        PivotFriction::new(
+            &model,
+            "trunk",
+            0.01,
+            0.001,
+            1e-3,
+            Some(Stribeck {
+                static_torque: 0.02,
+                velocity: 0.1,
+            }),
+        )
+        .unwrap(),
+    );
+    system.add_element(
+        AppliedLoad::force(
+            &model,
+            "push",
+            Attachment::on("twig11", [0.2, 0.0]),
+            [0.0, -1.0],
+            LoadFrame::Body,
+            PiecewiseLinear::new(vec![(0.0, 0.0), (0.1, 5.0), (0.2, 0.0)]).unwrap(),
+        )
+        .unwrap(),
+    );
+    system.add_element(AppliedLoad::torque(&model, "twist", "branch2", |t: f64| t.sin()).unwrap());
+    system
+        .prescribe("twig21", SmoothMove::new(0.0, 0.0, 0.5, 0.3).unwrap())
+        .unwrap();
+    let mut ws = system.workspace();
+    let x = system
+        .initial_state(0.0, &vec![0.2; model.nv()], &vec![-0.1; model.nv()])
+        .unwrap();
+    let mut xdot = vec![0.0; system.state_len()];
+    let mut s = vec![0.0; system.switch_len()];
+    let count = allocations_in(|| {
+        for k in 0..10 {
+            let t = 0.03 * k as f64;
+            system.derivative(&mut ws, t, &x, &mut xdot).unwrap();
+            system.switching_functions(&mut ws, t, &x, &mut s).unwrap();
+            system.energy(&mut ws, t, &x).unwrap();
+        }
+    });
+    assert_eq!(count, 0, "System::derivative allocated {count} times");
+    assert!(xdot.iter().all(|v| v.is_finite()));
+}
