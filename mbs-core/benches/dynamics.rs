@@ -1,1 +1,107 @@
-fn main() {}
+//! RNEA, CRBA, ABA and CRBA + Cholesky on the 5-link planar chain of the Pinocchio
+//! reference file and on the 13-body branching tree. Run with `cargo bench -p mbs-core`.
+//!
+//! Targets on a 2-core machine, release build: 5-link RNEA ≤ 0.25 µs, CRBA ≤ 0.2 µs,
+//! ABA ≤ 0.45 µs (native Pinocchio: 0.66 / 0.31 / 1.48 µs on the same chain).
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use mbs_core::benchmarks::{branching_tree, planar_chain};
+use mbs_core::{Data, Model, aba, crba, forward_dynamics_crba, rnea};
+
+/// The state of the reference file for the chain; a deterministic spread for the tree.
+fn state(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    if model.nv() == 5 {
+        (
+            vec![
+                1.721316619099806,
+                -0.38403808930179695,
+                2.2531371815723604,
+                1.2400999002927886,
+                -2.5498589250729733,
+            ],
+            vec![
+                1.9024894065470237,
+                1.0445588079614119,
+                1.1442572211078152,
+                -1.4875454692978165,
+                -0.19845624841773146,
+            ],
+            vec![
+                -1.2920197576741876,
+                4.267649888486018,
+                1.4386512008066452,
+                3.227616132708299,
+                -0.5658580117266885,
+            ],
+        )
+    } else {
+        let n = model.nv();
+        let f = |k: f64| {
+            (0..n)
+                .map(|i| ((i as f64 + 1.0) * k).sin() * 2.0)
+                .collect::<Vec<_>>()
+        };
+        (f(0.7), f(1.3), f(2.9))
+    }
+}
+
+fn bench_model(c: &mut Criterion, name: &str, model: &Model) {
+    let mut data = Data::new(model);
+    let (q, v, a) = state(model);
+    let tau = rnea(model, &mut data, &q, &v, &a)
+        .unwrap()
+        .as_slice()
+        .to_vec();
+    let mut group = c.benchmark_group(name);
+    group.bench_function("rnea", |b| {
+        b.iter(|| {
+            rnea(
+                model,
+                &mut data,
+                black_box(&q),
+                black_box(&v),
+                black_box(&a),
+            )
+            .unwrap()[0]
+        })
+    });
+    group.bench_function("crba", |b| {
+        b.iter(|| crba(model, &mut data, black_box(&q)).unwrap()[(0, 0)])
+    });
+    group.bench_function("aba", |b| {
+        b.iter(|| {
+            aba(
+                model,
+                &mut data,
+                black_box(&q),
+                black_box(&v),
+                black_box(&tau),
+            )
+            .unwrap()[0]
+        })
+    });
+    group.bench_function("crba_cholesky", |b| {
+        b.iter(|| {
+            forward_dynamics_crba(
+                model,
+                &mut data,
+                black_box(&q),
+                black_box(&v),
+                black_box(&tau),
+                None,
+            )
+            .unwrap()[0]
+        })
+    });
+    group.finish();
+}
+
+fn dynamics(c: &mut Criterion) {
+    bench_model(c, "planar5", &planar_chain(5));
+    bench_model(c, "tree13", &branching_tree());
+}
+
+criterion_group!(benches, dynamics);
+criterion_main!(benches);

@@ -58,6 +58,7 @@ pub mod elements;
 mod energy;
 mod error;
 mod force;
+pub mod inspect;
 mod jacobian;
 mod kinematics;
 mod model;

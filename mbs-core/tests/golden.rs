@@ -84,3 +84,45 @@ fn planar5_reproduces_pinocchio_to_1e12() {
         );
     }
 }
+
+#[test]
+fn inspect_reproduces_the_reference_expect_block() {
+    use mbs_core::inspect::{ReportFile, StatesFile, inspect};
+    let r = reference();
+    let model = Model::from_json_str(&r["model"].to_string()).unwrap();
+    let states = StatesFile::from_json_str(&r["states"].to_string()).unwrap();
+    let expect: ReportFile = serde_json::from_value(r["expect"].clone()).unwrap();
+    let got = inspect(&model, &states).unwrap();
+    assert_eq!(got.states.len(), expect.states.len());
+    for (g, e) in got.states.iter().zip(&expect.states) {
+        for (gr, er) in g.mass_matrix.iter().zip(&e.mass_matrix) {
+            assert_close("mass_matrix", gr, er, 1e-12);
+        }
+        assert_close("rnea_tau", &g.rnea_tau, &e.rnea_tau, 1e-12);
+        assert_close(
+            "nonlinear_effects",
+            &g.nonlinear_effects,
+            &e.nonlinear_effects,
+            1e-12,
+        );
+        assert_close(
+            "gravity_torque",
+            &g.gravity_torque,
+            &e.gravity_torque,
+            1e-12,
+        );
+        assert_close("aba_qdd", &g.aba_qdd, &e.aba_qdd, 1e-12);
+    }
+    // A state of the wrong size is named.
+    let bad =
+        StatesFile::from_json_str(r#"{"states": [{"q": [0], "v": [0], "a": [0], "tau": [0]}]}"#)
+            .unwrap();
+    let err = inspect(&model, &bad).unwrap_err().to_string();
+    assert!(
+        err.contains("states[0]") && err.contains("q: expected length 5"),
+        "{err}"
+    );
+    let err =
+        StatesFile::from_json_str(r#"{"states": [{"q": [0], "v": [0], "a": [0]}]}"#).unwrap_err();
+    assert!(err.to_string().contains("tau"), "{err}");
+}
