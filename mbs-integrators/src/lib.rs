@@ -6,4 +6,6 @@
 //!
 //! Until then it only re-exports the core so the workspace layout is in place.
 
+#![warn(missing_docs)]
+
 pub use mbs_core;

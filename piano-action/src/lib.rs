@@ -6,6 +6,8 @@
 //!
 //! Until then it only re-exports its dependencies so the workspace layout is in place.
 
+#![warn(missing_docs)]
+
 pub use mbs_contact;
 pub use mbs_core;
 pub use mbs_integrators;
