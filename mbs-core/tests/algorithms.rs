@@ -160,6 +160,102 @@ fn pendulum_period_matches_the_exact_large_amplitude_formula() {
     }
 }
 
+/// Times of upward zero crossings of coordinate 0 (about `offset`) over a run with RK4,
+/// each refined on the cubic Hermite interpolant of the step.
+fn upward_crossings(
+    f: &mut impl FnMut(&[f64], &mut [f64]),
+    x: &mut Vec<f64>,
+    offset: f64,
+    h: f64,
+    count: usize,
+) -> Vec<f64> {
+    let n = x.len() / 2;
+    let mut crossings = Vec::new();
+    let mut t = 0.0;
+    while crossings.len() < count && t < 100.0 {
+        let prev = x.clone();
+        rk4_step(f, x, h);
+        t += h;
+        let (e0, e1) = (prev[0] - offset, x[0] - offset);
+        if e0 < 0.0 && e1 >= 0.0 {
+            let (d0, d1) = (h * prev[n], h * x[n]);
+            let mut s = e0 / (e0 - e1);
+            for _ in 0..50 {
+                let p = (2.0 * s * s * s - 3.0 * s * s + 1.0) * e0
+                    + (s * s * s - 2.0 * s * s + s) * d0
+                    + (-2.0 * s * s * s + 3.0 * s * s) * e1
+                    + (s * s * s - s * s) * d1;
+                let dp = (6.0 * s * s - 6.0 * s) * e0
+                    + (3.0 * s * s - 4.0 * s + 1.0) * d0
+                    + (-6.0 * s * s + 6.0 * s) * e1
+                    + (3.0 * s * s - 2.0 * s) * d1;
+                s -= p / dp;
+            }
+            crossings.push(t - h + s * h);
+        }
+    }
+    crossings
+}
+
+#[test]
+fn double_pendulum_normal_mode_periods_match_the_linearised_closed_form() {
+    // Hanging at rest (q = (−π/2, 0)), small motions obey M₀ θ̈ + K θ = 0 with M₀ the acrobot
+    // mass matrix at q₂ = 0 and K the Hessian of the potential:
+    //   K11 = g (m1 lc1 + m2 (l1 + lc2)),  K12 = K22 = g m2 lc2.
+    // det(K − λ M₀) = 0 gives ω² = λ; started along a mode shape, the motion has period 2π/ω.
+    let (m1, m2, l1, lc1, lc2, i1, i2, g) = (1.1, 0.8, 1.2, 0.5, 0.7, 0.09, 0.13, 9.81);
+    let mut b = ModelBuilder::new();
+    b.gravity([0.0, -g])
+        .add_link(
+            "upper",
+            None,
+            JointKind::Revolute,
+            Placement::default(),
+            BodySpec::new(m1, [lc1, 0.0], i1),
+        )
+        .add_link(
+            "lower",
+            Some("upper"),
+            JointKind::Revolute,
+            Placement::offset(l1, 0.0),
+            BodySpec::new(m2, [lc2, 0.0], i2),
+        );
+    let model = b.build().unwrap();
+    let mut data = Data::new(&model);
+    let m11 = i1 + i2 + m1 * lc1 * lc1 + m2 * (l1 * l1 + lc2 * lc2 + 2.0 * l1 * lc2);
+    let m12 = i2 + m2 * (lc2 * lc2 + l1 * lc2);
+    let m22 = i2 + m2 * lc2 * lc2;
+    let (k11, k12, k22) = (g * (m1 * lc1 + m2 * (l1 + lc2)), g * m2 * lc2, g * m2 * lc2);
+    // (m11 m22 − m12²) λ² − (k11 m22 + k22 m11 − 2 k12 m12) λ + (k11 k22 − k12²) = 0
+    let qa = m11 * m22 - m12 * m12;
+    let qb = -(k11 * m22 + k22 * m11 - 2.0 * k12 * m12);
+    let qc = k11 * k22 - k12 * k12;
+    let disc = (qb * qb - 4.0 * qa * qc).sqrt();
+    for lambda in [(-qb - disc) / (2.0 * qa), (-qb + disc) / (2.0 * qa)] {
+        // Mode shape: (K − λ M₀) φ = 0 → φ = (−(k12 − λ m12), k11 − λ m11), signed so the
+        // first joint starts above its rest angle and next crosses it going up.
+        let mut phi = [-(k12 - lambda * m12), k11 - lambda * m11];
+        if phi[0] < 0.0 {
+            phi = [-phi[0], -phi[1]];
+        }
+        let scale = 1e-4 / phi[0].abs().max(phi[1].abs());
+        let mut x = vec![-PI / 2.0 + scale * phi[0], scale * phi[1], 0.0, 0.0];
+        let mut f = |x: &[f64], dx: &mut [f64]| {
+            let a = aba(&model, &mut data, &x[..2], &x[2..], &[0.0, 0.0]).unwrap();
+            dx[..2].copy_from_slice(&x[2..]);
+            dx[2..].copy_from_slice(a.as_slice());
+        };
+        let c = upward_crossings(&mut f, &mut x, -PI / 2.0, 2e-4, 3);
+        let period = c[2] - c[1];
+        let exact = 2.0 * PI / lambda.sqrt();
+        let rel = (period - exact).abs() / exact;
+        assert!(
+            rel < 1e-6,
+            "mode ω² = {lambda}: period {period}, linear theory {exact}, rel {rel:e}"
+        );
+    }
+}
+
 #[test]
 fn double_pendulum_matches_the_acrobot_closed_form() {
     // Acrobot (Drake multibody/benchmarks/acrobot) with angles from the x axis and gravity −y.
