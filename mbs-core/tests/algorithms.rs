@@ -122,35 +122,7 @@ fn pendulum_period_matches_the_exact_large_amplitude_formula() {
             dx[0] = x[1];
             dx[1] = a;
         };
-        // Times at which the pendulum passes the bottom moving in the positive direction.
-        let mut crossings = Vec::new();
-        let mut t = 0.0;
-        while crossings.len() < 3 {
-            let prev = x.clone();
-            rk4_step(&mut f, &mut x, h);
-            t += h;
-            let (e0, e1) = (prev[0] + PI / 2.0, x[0] + PI / 2.0);
-            if e0 < 0.0 && e1 >= 0.0 {
-                // Cubic Hermite root of the angle between the two steps.
-                let (mut s, mut it) = (e0 / (e0 - e1), 0);
-                while it < 50 {
-                    let (h00, h10, h01, h11) = (
-                        2.0 * s * s * s - 3.0 * s * s + 1.0,
-                        s * s * s - 2.0 * s * s + s,
-                        -2.0 * s * s * s + 3.0 * s * s,
-                        s * s * s - s * s,
-                    );
-                    let p = h00 * e0 + h10 * h * prev[1] + h01 * e1 + h11 * h * x[1];
-                    let dp = (6.0 * s * s - 6.0 * s) * e0
-                        + (3.0 * s * s - 4.0 * s + 1.0) * h * prev[1]
-                        + (-6.0 * s * s + 6.0 * s) * e1
-                        + (3.0 * s * s - 2.0 * s) * h * x[1];
-                    s -= p / dp;
-                    it += 1;
-                }
-                crossings.push(t - h + s * h);
-            }
-        }
+        let crossings = upward_crossings(&mut f, &mut x, -PI / 2.0, h, 3);
         let period = crossings[2] - crossings[1];
         let rel = (period - exact).abs() / exact;
         assert!(
@@ -164,7 +136,7 @@ fn pendulum_period_matches_the_exact_large_amplitude_formula() {
 /// each refined on the cubic Hermite interpolant of the step.
 fn upward_crossings(
     f: &mut impl FnMut(&[f64], &mut [f64]),
-    x: &mut Vec<f64>,
+    x: &mut [f64],
     offset: f64,
     h: f64,
     count: usize,
@@ -173,7 +145,7 @@ fn upward_crossings(
     let mut crossings = Vec::new();
     let mut t = 0.0;
     while crossings.len() < count && t < 100.0 {
-        let prev = x.clone();
+        let prev = x.to_vec();
         rk4_step(f, x, h);
         t += h;
         let (e0, e1) = (prev[0] - offset, x[0] - offset);
