@@ -17,17 +17,7 @@ pub fn frame_jacobian(
     p_b: [f64; 2],
     out: &mut DMatrix<f64>,
 ) -> Result<()> {
-    check_shape(model, out, 3)?;
-    out.fill(0.0);
-    let p = data.x_world[body.0].transform_point(p_b);
-    for j in model.support(body) {
-        let (w, lin) = column(model, data, j, p);
-        let k = model.bodies[j.0].idx_v;
-        out[(0, k)] = w;
-        out[(1, k)] = lin[0];
-        out[(2, k)] = lin[1];
-    }
-    Ok(())
+    fill(model, data, body, p_b, out, true)
 }
 
 /// The 2 × nv Jacobian of the world velocity of the point `p_b` fixed to `body` (given in
@@ -40,14 +30,32 @@ pub fn point_jacobian(
     p_b: [f64; 2],
     out: &mut DMatrix<f64>,
 ) -> Result<()> {
-    check_shape(model, out, 2)?;
+    fill(model, data, body, p_b, out, false)
+}
+
+/// Writes the Jacobian columns of the joints supporting `body`, with the angular row first
+/// when `angular` is set.
+fn fill(
+    model: &Model,
+    data: &Data,
+    body: BodyId,
+    p_b: [f64; 2],
+    out: &mut DMatrix<f64>,
+    angular: bool,
+) -> Result<()> {
+    let rows = if angular { 3 } else { 2 };
+    check_shape(model, out, rows)?;
     out.fill(0.0);
     let p = data.x_world[body.0].transform_point(p_b);
+    let r0 = rows - 2;
     for j in model.support(body) {
-        let (_, lin) = column(model, data, j, p);
+        let (w, lin) = column(model, data, j, p);
         let k = model.bodies[j.0].idx_v;
-        out[(0, k)] = lin[0];
-        out[(1, k)] = lin[1];
+        if angular {
+            out[(0, k)] = w;
+        }
+        out[(r0, k)] = lin[0];
+        out[(r0 + 1, k)] = lin[1];
     }
     Ok(())
 }

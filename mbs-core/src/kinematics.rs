@@ -9,7 +9,7 @@ use crate::spatial::{Motion, Transform};
 /// Computes the world pose of every body for configuration `q`.
 pub fn update_poses(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
     check_input("q", q, model.nv())?;
-    poses_pass(model, data, q);
+    kinematics_pass(model, data, q, None);
     Ok(())
 }
 
@@ -17,7 +17,7 @@ pub fn update_poses(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> Result<()> {
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
-    kinematics_pass(model, data, q, v);
+    kinematics_pass(model, data, q, Some(v));
     Ok(())
 }
 
@@ -45,19 +45,9 @@ pub fn forward_kinematics_acc(
     Ok(())
 }
 
-/// Joint transforms and world poses.
-pub(crate) fn poses_pass(model: &Model, data: &mut Data, q: &[f64]) {
-    data.x_world[0] = Transform::IDENTITY;
-    for i in 1..model.bodies.len() {
-        let b = &model.bodies[i];
-        let x = b.joint_transform(q[b.idx_v]);
-        data.x_up[i] = x;
-        data.x_world[i] = data.x_world[b.parent].compose(&x);
-    }
-}
-
-/// Joint transforms, world poses and body velocities (inputs already checked).
-pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
+/// Joint transforms, world poses and, when `v` is given, body velocities (inputs already
+/// checked).
+pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: Option<&[f64]>) {
     data.x_world[0] = Transform::IDENTITY;
     data.v[0] = Motion::ZERO;
     for i in 1..model.bodies.len() {
@@ -65,8 +55,10 @@ pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: &[f6
         let x = b.joint_transform(q[b.idx_v]);
         data.x_up[i] = x;
         data.x_world[i] = data.x_world[b.parent].compose(&x);
-        // v_i = X v_λ + S q̇
-        data.v[i] = x.apply_motion(&data.v[b.parent]) + b.s * v[b.idx_v];
+        if let Some(v) = v {
+            // v_i = X v_λ + S q̇
+            data.v[i] = x.apply_motion(&data.v[b.parent]) + b.s * v[b.idx_v];
+        }
     }
 }
 

@@ -308,7 +308,7 @@ impl System {
                 ws.qdd_prescribed[k] = s.a;
             }
         }
-        kinematics_pass(&self.model, &mut ws.data, &ws.q, &ws.v);
+        kinematics_pass(&self.model, &mut ws.data, &ws.q, Some(&ws.v));
         Ok(())
     }
 
