@@ -294,6 +294,25 @@ impl System {
         })
     }
 
+    /// What element code sees: kinematics of the workspace, time and its own states.
+    fn context<'a>(
+        &'a self,
+        data: &'a Data,
+        q: &'a [f64],
+        v: &'a [f64],
+        t: f64,
+        states: &'a [f64],
+    ) -> ForceContext<'a> {
+        ForceContext {
+            model: &self.model,
+            data,
+            t,
+            q,
+            v,
+            states,
+        }
+    }
+
     /// Loads q, v (drives applied) and runs kinematics.
     fn prepare(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<()> {
         self.check_state(t, x)?;
@@ -337,14 +356,7 @@ impl System {
         let (head, rates) = xdot.split_at_mut(2 * nv);
         for (e, el) in self.elements.iter().enumerate() {
             let r = self.element_state_range(e);
-            let ctx = ForceContext {
-                model: &self.model,
-                data: &ws.data,
-                t,
-                q: &ws.q,
-                v: &ws.v,
-                states: &x[r.clone()],
-            };
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r.clone()]);
             let mut loads = Loads {
                 tau: &mut ws.tau,
                 body_forces: &mut ws.forces_world,
@@ -412,14 +424,7 @@ impl System {
             let r = self.element_state_range(e);
             ws.scratch_tau.fill(0.0);
             ws.scratch_forces.fill(Force::ZERO);
-            let ctx = ForceContext {
-                model: &self.model,
-                data: &ws.data,
-                t,
-                q: &ws.q,
-                v: &ws.v,
-                states: &x[r.clone()],
-            };
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r.clone()]);
             let mut loads = Loads {
                 tau: &mut ws.scratch_tau,
                 body_forces: &mut ws.scratch_forces,
@@ -463,14 +468,7 @@ impl System {
         self.prepare(ws, t, x)?;
         for (e, el) in self.elements.iter().enumerate() {
             let r = self.element_state_range(e);
-            let ctx = ForceContext {
-                model: &self.model,
-                data: &ws.data,
-                t,
-                q: &ws.q,
-                v: &ws.v,
-                states: &x[r],
-            };
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r]);
             let start = self.switch_offsets[e];
             el.switching_functions(&ctx, &mut out[start..start + el.switch_count()]);
         }
@@ -483,14 +481,7 @@ impl System {
         let mut elastic = 0.0;
         for (e, el) in self.elements.iter().enumerate() {
             let r = self.element_state_range(e);
-            let ctx = ForceContext {
-                model: &self.model,
-                data: &ws.data,
-                t,
-                q: &ws.q,
-                v: &ws.v,
-                states: &x[r],
-            };
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r]);
             elastic += el.potential_energy(&ctx);
         }
         Ok(Energy {
