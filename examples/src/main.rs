@@ -5,7 +5,7 @@
 
 use std::process::ExitCode;
 
-use mbs_core::elements::PivotFriction;
+use mbs_core::elements::{FrictionLaw, PivotFriction};
 use mbs_core::{Model, System};
 
 /// Two 0.5 kg, 0.4 m rods (inertia m l²/12 about their centres) hanging from the ground.
@@ -109,9 +109,8 @@ fn run() -> mbs_core::Result<()> {
     )?;
     let mut rubbing = System::new(model.clone());
     for joint in ["upper", "lower"] {
-        rubbing.add_element(PivotFriction::new(
-            &model, joint, 0.005, 0.0005, 1e-3, None,
-        )?);
+        let law = FrictionLaw::coulomb(0.005, 1e-3).with_viscous(0.0005);
+        rubbing.add_element(PivotFriction::new(&model, joint, law)?)?;
     }
     simulate(
         "With 5 mN·m Coulomb + viscous friction at each pivot: energy drains away.",

@@ -32,6 +32,7 @@ pub fn aba<'d>(
     v: &[f64],
     tau: &[f64],
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("tau", tau, model.nv())?;
@@ -50,6 +51,7 @@ pub fn aba_with_forces<'d>(
     tau: &[f64],
     f_ext: &[Force],
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("tau", tau, model.nv())?;
@@ -87,6 +89,7 @@ pub fn hybrid_dynamics(
     f_ext: Option<&[Force]>,
 ) -> Result<()> {
     let n = model.nv();
+    data.check(model)?;
     check_input("q", q, n)?;
     check_input("v", v, n)?;
     if prescribed.mask.len() != n {
@@ -123,13 +126,14 @@ fn check_masked(what: &'static str, x: &[f64], n: usize, mask: &[bool], want: bo
     Ok(())
 }
 
-/// Joint transforms and body velocities (no world poses: ABA does not need them).
+/// Joint transforms, world poses and body velocities.
 fn velocity_pass(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
     data.v[0] = Motion::ZERO;
     for i in 1..model.bodies.len() {
         let b = &model.bodies[i];
         let x = b.joint_transform(q[b.idx_v]);
         data.x_up[i] = x;
+        data.x_world[i] = data.x_world[b.parent].compose(&x);
         data.v[i] = x.apply_motion(&data.v[b.parent]) + b.s * v[b.idx_v];
     }
 }

@@ -7,7 +7,9 @@ use crate::model::Model;
 /// Featherstone's `planar(n)` chain (spatial_v2): `n` unit links of 1 kg along their x axes,
 /// centre of mass at mid-link, inertia 1/12 kg·m² about it, revolute joints at the link
 /// ends, gravity (0, −9.81). `planar_chain(5)` is the model of the Pinocchio reference file.
+/// `n = 0` is taken as 1 (a model needs a moving body).
 pub fn planar_chain(n: usize) -> Model {
+    let n = n.max(1);
     let mut b = ModelBuilder::new();
     b.gravity([0.0, -9.81]);
     for i in 0..n {

@@ -12,6 +12,7 @@ use crate::spatial::Force;
 /// The joint-space mass matrix `M(q)` (full and symmetric), written to
 /// `data.mass_matrix()` and returned.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMatrix<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     crba_pass(model, data, q);
     Ok(&data.mass_matrix)
@@ -22,7 +23,9 @@ pub(crate) fn crba_pass(model: &Model, data: &mut Data, q: &[f64]) {
     let nb = bodies.len();
     for i in 1..nb {
         let b = &bodies[i];
-        data.x_up[i] = b.joint_transform(q[b.idx_v]);
+        let x = b.joint_transform(q[b.idx_v]);
+        data.x_up[i] = x;
+        data.x_world[i] = data.x_world[b.parent].compose(&x);
         data.ic[i] = b.inertia;
     }
     // IC_λ += Xᵀ IC_i X
@@ -57,7 +60,8 @@ pub(crate) fn crba_pass(model: &Model, data: &mut Data, q: &[f64]) {
 /// Forward dynamics by CRBA and Cholesky: `q̈ = M⁻¹ (τ − C v − g)`, written to
 /// `data.qdd()` and returned. Equal to [`crate::aba`] to rounding; cheaper when the mass
 /// matrix is wanted anyway (implicit integrators, contact Jacobians). Also leaves
-/// `data.mass_matrix()` and `data.nonlinear_effects()` filled.
+/// `data.mass_matrix()` filled, and `data.nonlinear_effects()` holding `C v + g − Σ Jᵀ f_ext`
+/// (the external forces included when given).
 pub fn forward_dynamics_crba<'d>(
     model: &Model,
     data: &'d mut Data,
@@ -66,6 +70,7 @@ pub fn forward_dynamics_crba<'d>(
     tau: &[f64],
     f_ext: Option<&[Force]>,
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("tau", tau, model.nv())?;

@@ -76,6 +76,17 @@ impl Data {
         }
     }
 
+    /// Checks that this workspace was made for a model of `model`'s size.
+    pub(crate) fn check(&self, model: &Model) -> crate::Result<()> {
+        if self.x_up.len() != model.nbodies() || self.tau.len() != model.nv() {
+            return Err(crate::CoreError::WorkspaceMismatch {
+                expected: model.nbodies(),
+                got: self.x_up.len(),
+            });
+        }
+        Ok(())
+    }
+
     /// Generalized forces from the last [`crate::rnea`] (or the driving forces and given
     /// forces of [`crate::hybrid_dynamics`]).
     pub fn tau(&self) -> &DVector<f64> {
@@ -102,8 +113,8 @@ impl Data {
         &self.gravity
     }
 
-    /// World pose of a body's joint frame (after [`crate::forward_kinematics`] or
-    /// [`crate::update_poses`]).
+    /// World pose of a body's joint frame, for the configuration of the last call of any
+    /// algorithm (kinematics, dynamics or energy).
     pub fn body_pose(&self, body: BodyId) -> Transform {
         self.x_world[body.0]
     }
@@ -113,9 +124,23 @@ impl Data {
         self.v[body.0]
     }
 
-    /// Spatial acceleration of a body in its own frame, gravity excluded (after
-    /// [`crate::forward_kinematics_acc`]).
+    /// Spatial acceleration of a body in its own frame, gravity excluded, from the last call
+    /// that computes accelerations ([`crate::forward_kinematics_acc`], [`crate::rnea`],
+    /// [`crate::aba`], [`crate::hybrid_dynamics`], `System::derivative`).
+    ///
+    /// The dynamics algorithms run with the base accelerating at −g (Featherstone's way of
+    /// applying gravity), stored in `a[0]`; it is removed here.
     pub fn body_acceleration(&self, body: BodyId) -> Motion {
-        self.a[body.0]
+        let a0 = self.a[0];
+        let g_b = self.x_world[body.0].rotate_inv([a0.vx, a0.vy]);
+        let a = self.a[body.0];
+        Motion::new(a.w, a.vx - g_b[0], a.vy - g_b[1])
+    }
+
+    /// The spatial force each joint transmits from the parent to the body (the body
+    /// frame's origin, body coordinates), from the last [`crate::rnea`]: joint reaction
+    /// plus actuation. Its component along the joint's axis is the generalized force.
+    pub fn joint_force(&self, body: BodyId) -> Force {
+        self.f[body.0]
     }
 }

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::error::{CoreError, Result};
-use crate::force::{Crossing, ForceContext, ForceElement, Loads};
+use crate::force::{Crossing, ForceContext, ForceElement, Loads, check_coordinate, check_frame};
 use crate::kinematics::frame_point;
 use crate::model::{BodyId, Model};
 use crate::time_function::TimeFunction;
@@ -74,20 +74,35 @@ impl SpringLaw {
 #[derive(Clone, Debug, PartialEq)]
 pub struct JointSpringDamper {
     name: String,
+    joint: String,
     coordinate: usize,
     law: SpringLaw,
 }
 
 impl JointSpringDamper {
-    /// A spring–damper on the joint named `joint`; stiffness and damping must be
-    /// non-negative and everything finite.
+    /// A spring–damper on the joint named `joint`, named after it; stiffness and damping
+    /// must be non-negative and everything finite.
     pub fn new(model: &Model, joint: &str, law: SpringLaw) -> Result<Self> {
         let name = format!("joint spring '{joint}'");
         Ok(Self {
             coordinate: model.coordinate_id(joint)?,
             law: law.validated(&name, false)?,
+            joint: joint.to_string(),
             name,
         })
+    }
+
+    /// The same element under another name.
+    pub fn named(self, name: &str) -> Self {
+        Self {
+            name: name.to_string(),
+            ..self
+        }
+    }
+
+    /// The spring's parameters.
+    pub fn law(&self) -> SpringLaw {
+        self.law
     }
 
     /// The generalized force for coordinate value `q` and rate `v`.
@@ -102,6 +117,10 @@ impl ForceElement for JointSpringDamper {
         &self.name
     }
 
+    fn check_model(&self, model: &Model) -> Result<()> {
+        check_coordinate(model, &self.name, &self.joint, self.coordinate)
+    }
+
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
         let k = self.coordinate;
         loads.add_generalized(k, self.force(ctx.q[k], ctx.v[k]));
@@ -113,8 +132,9 @@ impl ForceElement for JointSpringDamper {
     }
 }
 
-/// One end of a point-to-point element: a frame name (`None` for the ground) and a point
-/// given in that frame (in world coordinates for the ground).
+/// One end of a point-to-point element or the point of an applied force: a frame name
+/// (`None` for the ground) and a point given in that frame (in world coordinates for the
+/// ground).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Attachment<'a> {
     /// Frame name, `None` for the ground.
@@ -137,13 +157,32 @@ impl<'a> Attachment<'a> {
         Self { frame: None, point }
     }
 
-    fn resolve(&self, model: &Model, item: &str) -> Result<(BodyId, [f64; 2])> {
+    fn resolve(&self, model: &Model, item: &str) -> Result<ResolvedPoint> {
         param(item, "point[0]", self.point[0], false)?;
         param(item, "point[1]", self.point[1], false)?;
-        match self.frame {
-            None => Ok((BodyId::GROUND, self.point)),
-            Some(f) => Ok(frame_point(model, model.frame_id(f)?, self.point)),
-        }
+        let (body, point) = match self.frame {
+            None => (BodyId::GROUND, self.point),
+            Some(f) => frame_point(model, model.frame_id(f)?, self.point),
+        };
+        Ok(ResolvedPoint {
+            frame: self.frame.map(str::to_string),
+            body,
+            point,
+        })
+    }
+}
+
+/// An attachment resolved on a model: the body carrying it and the point in its frame.
+#[derive(Clone, Debug, PartialEq)]
+struct ResolvedPoint {
+    frame: Option<String>,
+    body: BodyId,
+    point: [f64; 2],
+}
+
+impl ResolvedPoint {
+    fn check(&self, model: &Model, item: &str) -> Result<()> {
+        check_frame(model, item, self.frame.as_deref(), self.body)
     }
 }
 
@@ -154,14 +193,15 @@ impl<'a> Attachment<'a> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PointSpringDamper {
     name: String,
-    a: (BodyId, [f64; 2]),
-    b: (BodyId, [f64; 2]),
+    a: ResolvedPoint,
+    b: ResolvedPoint,
     law: SpringLaw,
 }
 
 impl PointSpringDamper {
     /// A spring–damper from `a` to `b`; stiffness, damping and rest length must be
-    /// non-negative (the preload is the tension at rest length).
+    /// non-negative (the preload is the tension at rest length). At least one end must be
+    /// on a moving body.
     pub fn new(
         model: &Model,
         name: &str,
@@ -170,18 +210,31 @@ impl PointSpringDamper {
         law: SpringLaw,
     ) -> Result<Self> {
         let item = format!("point spring '{name}'");
+        let a = a.resolve(model, &format!("{item}.a"))?;
+        let b = b.resolve(model, &format!("{item}.b"))?;
+        if a.body == BodyId::GROUND && b.body == BodyId::GROUND {
+            return Err(CoreError::InvalidParameter {
+                item,
+                message: "both ends are fixed to the ground, so it would act on nothing".into(),
+            });
+        }
         Ok(Self {
-            a: a.resolve(model, &format!("{item}.a"))?,
-            b: b.resolve(model, &format!("{item}.b"))?,
+            a,
+            b,
             law: law.validated(&item, true)?,
             name: item,
         })
     }
 
+    /// The spring's parameters.
+    pub fn law(&self) -> SpringLaw {
+        self.law
+    }
+
     /// Current length (m), from the poses in `ctx`.
     pub fn length(&self, ctx: &ForceContext<'_>) -> f64 {
-        let pa = ctx.point_position(self.a.0, self.a.1);
-        let pb = ctx.point_position(self.b.0, self.b.1);
+        let pa = ctx.point_position(self.a.body, self.a.point);
+        let pb = ctx.point_position(self.b.body, self.b.point);
         (pb[0] - pa[0]).hypot(pb[1] - pa[1])
     }
 }
@@ -191,23 +244,29 @@ impl ForceElement for PointSpringDamper {
         &self.name
     }
 
+    fn check_model(&self, model: &Model) -> Result<()> {
+        self.a.check(model, &self.name)?;
+        self.b.check(model, &self.name)
+    }
+
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
-        let pa = ctx.point_position(self.a.0, self.a.1);
-        let pb = ctx.point_position(self.b.0, self.b.1);
+        let (a, b) = (&self.a, &self.b);
+        let pa = ctx.point_position(a.body, a.point);
+        let pb = ctx.point_position(b.body, b.point);
         let d = [pb[0] - pa[0], pb[1] - pa[1]];
         let l = d[0].hypot(d[1]);
         if l.is_nan() || l <= 1e-12 {
             return;
         }
         let u = [d[0] / l, d[1] / l];
-        let va = ctx.point_velocity(self.a.0, self.a.1);
-        let vb = ctx.point_velocity(self.b.0, self.b.1);
+        let va = ctx.point_velocity(a.body, a.point);
+        let vb = ctx.point_velocity(b.body, b.point);
         // l̇ = (v_b − v_a) · u ;  T = preload + k (l − l₀) + c l̇
         let ldot = (vb[0] - va[0]) * u[0] + (vb[1] - va[1]) * u[1];
         let law = &self.law;
         let t = law.preload + law.stiffness * (l - law.rest) + law.damping * ldot;
-        loads.add_force_at_point(self.a.0, pa, [t * u[0], t * u[1]]);
-        loads.add_force_at_point(self.b.0, pb, [-t * u[0], -t * u[1]]);
+        loads.add_force_at_point(a.body, pa, [t * u[0], t * u[1]]);
+        loads.add_force_at_point(b.body, pb, [-t * u[0], -t * u[1]]);
     }
 
     fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
@@ -226,46 +285,61 @@ pub struct Stribeck {
     pub velocity: f64,
 }
 
-/// Friction in a pivot (or slider): regularised Coulomb plus viscous, with an optional
-/// Stribeck peak:
-/// `τ = −[(T_c + (T_s − T_c) e^{−(v/v_s)²}) tanh(v / v_ε) + b v]`.
-/// `v_ε` (the regularisation velocity) sets how sharply the friction torque reverses; the
-/// element's switching function is the joint velocity, so an integrator can locate
-/// stick–slip reversals.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PivotFriction {
-    name: String,
-    coordinate: usize,
-    coulomb: f64,
-    viscous: f64,
-    stribeck: Option<Stribeck>,
-    regularization: f64,
+/// Parameters of pivot friction (see [`PivotFriction`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrictionLaw {
+    /// Coulomb (kinetic) friction torque (N·m, or N on a slider), non-negative.
+    pub coulomb: f64,
+    /// Viscous coefficient (N·m·s/rad, or N·s/m), non-negative.
+    pub viscous: f64,
+    /// Regularisation velocity `v_ε` of the `tanh` (rad/s or m/s), positive: smaller is
+    /// closer to true Coulomb friction and stiffer for the integrator.
+    pub regularization: f64,
+    /// Optional Stribeck peak.
+    pub stribeck: Option<Stribeck>,
 }
 
-impl PivotFriction {
-    /// Friction on the joint named `joint`: Coulomb torque `coulomb` (N·m), viscous
-    /// coefficient `viscous` (N·m·s/rad), regularisation velocity `regularization` (rad/s,
-    /// positive), optional Stribeck peak.
-    pub fn new(
-        model: &Model,
-        joint: &str,
-        coulomb: f64,
-        viscous: f64,
-        regularization: f64,
-        stribeck: Option<Stribeck>,
-    ) -> Result<Self> {
-        let name = format!("pivot friction '{joint}'");
-        let coulomb = param(&name, "coulomb", coulomb, true)?;
-        let regularization = param(&name, "regularization", regularization, true)?;
+impl FrictionLaw {
+    /// Coulomb friction `coulomb`, regularised over `regularization`; no viscous part, no
+    /// Stribeck peak.
+    pub fn coulomb(coulomb: f64, regularization: f64) -> Self {
+        Self {
+            coulomb,
+            viscous: 0.0,
+            regularization,
+            stribeck: None,
+        }
+    }
+
+    /// The same law with viscous coefficient `viscous`.
+    pub fn with_viscous(self, viscous: f64) -> Self {
+        Self { viscous, ..self }
+    }
+
+    /// The same law with a Stribeck peak.
+    pub fn with_stribeck(self, static_torque: f64, velocity: f64) -> Self {
+        Self {
+            stribeck: Some(Stribeck {
+                static_torque,
+                velocity,
+            }),
+            ..self
+        }
+    }
+
+    fn validated(self, name: &str) -> Result<Self> {
+        let coulomb = param(name, "coulomb", self.coulomb, true)?;
+        let viscous = param(name, "viscous", self.viscous, true)?;
+        let regularization = param(name, "regularization", self.regularization, true)?;
         if regularization <= 0.0 {
             return Err(CoreError::InvalidParameter {
                 item: format!("{name}.regularization"),
                 message: "must be positive".into(),
             });
         }
-        if let Some(s) = stribeck {
-            param(&name, "stribeck.static_torque", s.static_torque, true)?;
-            param(&name, "stribeck.velocity", s.velocity, true)?;
+        if let Some(s) = self.stribeck {
+            param(name, "stribeck.static_torque", s.static_torque, true)?;
+            param(name, "stribeck.velocity", s.velocity, true)?;
             if s.velocity <= 0.0 || s.static_torque < coulomb {
                 return Err(CoreError::InvalidParameter {
                     item: format!("{name}.stribeck"),
@@ -276,25 +350,76 @@ impl PivotFriction {
             }
         }
         Ok(Self {
-            coordinate: model.coordinate_id(joint)?,
             coulomb,
-            viscous: param(&name, "viscous", viscous, true)?,
-            stribeck,
+            viscous,
             regularization,
-            name,
+            stribeck: self.stribeck,
         })
+    }
+}
+
+/// Friction in a pivot (or slider): regularised Coulomb plus viscous, with an optional
+/// Stribeck peak:
+/// `τ = −[(T_c + (T_s − T_c) e^{−(v/v_s)²}) tanh(v / v_ε) + b v]`.
+///
+/// The law is smooth, so by default it declares no switching function; with
+/// [`PivotFriction::with_reversal_events`] the joint velocity becomes one, for integrators
+/// that should stop at each reversal (stick–slip studies).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PivotFriction {
+    name: String,
+    joint: String,
+    coordinate: usize,
+    law: FrictionLaw,
+    reversal_events: bool,
+}
+
+impl PivotFriction {
+    /// Friction on the joint named `joint`, named after it.
+    pub fn new(model: &Model, joint: &str, law: FrictionLaw) -> Result<Self> {
+        let name = format!("pivot friction '{joint}'");
+        Ok(Self {
+            coordinate: model.coordinate_id(joint)?,
+            law: law.validated(&name)?,
+            joint: joint.to_string(),
+            name,
+            reversal_events: false,
+        })
+    }
+
+    /// The same element under another name.
+    pub fn named(self, name: &str) -> Self {
+        Self {
+            name: name.to_string(),
+            ..self
+        }
+    }
+
+    /// The same element, declaring the joint velocity as a switching function (an event at
+    /// each reversal of the motion).
+    pub fn with_reversal_events(self) -> Self {
+        Self {
+            reversal_events: true,
+            ..self
+        }
+    }
+
+    /// The friction parameters.
+    pub fn law(&self) -> FrictionLaw {
+        self.law
     }
 
     /// Friction torque at joint velocity `v`.
     pub fn torque(&self, v: f64) -> f64 {
-        let level = match self.stribeck {
-            None => self.coulomb,
+        let law = &self.law;
+        let level = match law.stribeck {
+            None => law.coulomb,
             Some(s) => {
                 let r = v / s.velocity;
-                self.coulomb + (s.static_torque - self.coulomb) * (-r * r).exp()
+                law.coulomb + (s.static_torque - law.coulomb) * (-r * r).exp()
             }
         };
-        -(level * (v / self.regularization).tanh() + self.viscous * v)
+        -(level * (v / law.regularization).tanh() + law.viscous * v)
     }
 }
 
@@ -303,17 +428,23 @@ impl ForceElement for PivotFriction {
         &self.name
     }
 
+    fn check_model(&self, model: &Model) -> Result<()> {
+        check_coordinate(model, &self.name, &self.joint, self.coordinate)
+    }
+
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
         let k = self.coordinate;
         loads.add_generalized(k, self.torque(ctx.v[k]));
     }
 
     fn switch_count(&self) -> usize {
-        1
+        usize::from(self.reversal_events)
     }
 
     fn switching_functions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
-        out[0] = ctx.v[self.coordinate];
+        if let Some(s) = out.first_mut() {
+            *s = ctx.v[self.coordinate];
+        }
     }
 
     fn switch_direction(&self, _k: usize) -> Crossing {
@@ -345,6 +476,7 @@ enum LoadKind {
 #[derive(Clone)]
 pub struct AppliedLoad {
     name: String,
+    frame: String,
     body: BodyId,
     kind: LoadKind,
     magnitude: Arc<dyn TimeFunction>,
@@ -354,15 +486,35 @@ impl std::fmt::Debug for AppliedLoad {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("AppliedLoad")
             .field("name", &self.name)
-            .field("body", &self.body)
+            .field("frame", &self.frame)
             .finish_non_exhaustive()
     }
 }
 
+fn moving_frame(model: &Model, item: &str, frame: Option<&str>) -> Result<(String, BodyId)> {
+    let Some(frame) = frame else {
+        return Err(CoreError::InvalidParameter {
+            item: item.to_string(),
+            message: "a load on the ground acts on nothing: attach it to a moving body".into(),
+        });
+    };
+    let body = model.frame(model.frame_id(frame)?).body;
+    if body == BodyId::GROUND {
+        return Err(CoreError::InvalidParameter {
+            item: item.to_string(),
+            message: format!(
+                "frame '{frame}' is fixed to the ground, so the load would act on nothing"
+            ),
+        });
+    }
+    Ok((frame.to_string(), body))
+}
+
 impl AppliedLoad {
-    /// A force `magnitude(t) · direction` at `point` of the named frame (both in frame
-    /// coordinates when `frame` is [`LoadFrame::Body`]; the direction in world coordinates
-    /// when it is [`LoadFrame::World`]). `direction` is used as given (not normalised).
+    /// A force `magnitude(t) · direction` at `at` (a point of a moving frame). With
+    /// [`LoadFrame::Body`] the direction is given in the frame and turns with it; with
+    /// [`LoadFrame::World`] it is fixed in world coordinates. `direction` is used as given
+    /// (not normalised).
     pub fn force(
         model: &Model,
         name: &str,
@@ -372,20 +524,23 @@ impl AppliedLoad {
         magnitude: impl TimeFunction + 'static,
     ) -> Result<Self> {
         let item = format!("applied force '{name}'");
-        let (body, point) = at.resolve(model, &item)?;
+        let (frame_name, _) = moving_frame(model, &item, at.frame)?;
+        let resolved = at.resolve(model, &item)?;
         param(&item, "direction[0]", direction[0], false)?;
         param(&item, "direction[1]", direction[1], false)?;
-        let direction = match (at.frame, frame) {
-            (Some(f), LoadFrame::Body) => {
-                model.frame(model.frame_id(f)?).placement.rotate(direction)
-            }
-            _ => direction,
+        let direction = match frame {
+            LoadFrame::Body => model
+                .frame(model.frame_id(&frame_name)?)
+                .placement
+                .rotate(direction),
+            LoadFrame::World => direction,
         };
         Ok(Self {
             name: item,
-            body,
+            frame: frame_name,
+            body: resolved.body,
             kind: LoadKind::Force {
-                point,
+                point: resolved.point,
                 direction,
                 frame,
             },
@@ -400,9 +555,12 @@ impl AppliedLoad {
         frame: &str,
         magnitude: impl TimeFunction + 'static,
     ) -> Result<Self> {
+        let item = format!("applied torque '{name}'");
+        let (frame, body) = moving_frame(model, &item, Some(frame))?;
         Ok(Self {
-            name: format!("applied torque '{name}'"),
-            body: model.frame(model.frame_id(frame)?).body,
+            name: item,
+            frame,
+            body,
             kind: LoadKind::Torque,
             magnitude: Arc::new(magnitude),
         })
@@ -412,6 +570,10 @@ impl AppliedLoad {
 impl ForceElement for AppliedLoad {
     fn name(&self) -> &str {
         &self.name
+    }
+
+    fn check_model(&self, model: &Model) -> Result<()> {
+        check_frame(model, &self.name, Some(&self.frame), self.body)
     }
 
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {

@@ -113,6 +113,24 @@ pub enum CoreError {
         /// The length given.
         got: usize,
     },
+    /// A `Data` or `Workspace` made for another model was passed.
+    #[error("workspace made for a model of {got} bodies used with a model of {expected}")]
+    WorkspaceMismatch {
+        /// Bodies (with the ground) of the model given.
+        expected: usize,
+        /// Bodies the workspace was made for.
+        got: usize,
+    },
+    /// A matrix argument has the wrong shape.
+    #[error("{what}: expected a {}×{} matrix, got {}×{}", expected.0, expected.1, got.0, got.1)]
+    ShapeMismatch {
+        /// Which argument.
+        what: &'static str,
+        /// Rows and columns needed.
+        expected: (usize, usize),
+        /// Rows and columns given.
+        got: (usize, usize),
+    },
     /// An input to an algorithm holds NaN or an infinity.
     #[error("{what}[{index}] is not finite ({value})")]
     NonFiniteInput {

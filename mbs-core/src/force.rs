@@ -6,6 +6,53 @@ use crate::kinematics;
 use crate::model::{BodyId, Model};
 use crate::spatial::{Force, Transform};
 
+/// Checks that coordinate `k` of `model` is the joint `joint` (for elements built on one
+/// model and added to a system of another).
+pub(crate) fn check_coordinate(
+    model: &Model,
+    element: &str,
+    joint: &str,
+    k: usize,
+) -> crate::Result<()> {
+    if model.coordinate_id(joint).ok() == Some(k) {
+        Ok(())
+    } else {
+        Err(crate::CoreError::InvalidParameter {
+            item: element.to_string(),
+            message: format!(
+                "built for another model: this model's coordinate {k} is not joint '{joint}'"
+            ),
+        })
+    }
+}
+
+/// Checks that `frame` of `model` is carried by `body` (see [`check_coordinate`]).
+pub(crate) fn check_frame(
+    model: &Model,
+    element: &str,
+    frame: Option<&str>,
+    body: BodyId,
+) -> crate::Result<()> {
+    let ok = match frame {
+        None => body == BodyId::GROUND,
+        Some(f) => model
+            .frame_id(f)
+            .map(|id| model.frame(id).body == body)
+            .unwrap_or(false),
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(crate::CoreError::InvalidParameter {
+            item: element.to_string(),
+            message: format!(
+                "built for another model: frame '{}' is not on the same body here",
+                frame.unwrap_or("ground")
+            ),
+        })
+    }
+}
+
 /// What a force element sees when it is evaluated: the model, the kinematics of the current
 /// state (world poses and body velocities are up to date), time, coordinates and the
 /// element's own internal states.
@@ -54,7 +101,24 @@ pub struct Loads<'a> {
     pub(crate) body_forces: &'a mut [Force],
 }
 
-impl Loads<'_> {
+impl<'a> Loads<'a> {
+    /// Loads accumulating into `tau` (length nv) and `body_forces` (world spatial forces about
+    /// the world origin, length nbodies). `System` makes these; build one directly to test an
+    /// element's [`ForceElement::apply`] on its own.
+    pub fn new(tau: &'a mut [f64], body_forces: &'a mut [Force]) -> Self {
+        Self { tau, body_forces }
+    }
+
+    /// Generalized forces added so far.
+    pub fn generalized(&self) -> &[f64] {
+        self.tau
+    }
+
+    /// World spatial forces (about the world origin) added so far, per body.
+    pub fn body_forces(&self) -> &[Force] {
+        self.body_forces
+    }
+
     /// Adds `value` to the generalized force of coordinate `k`.
     #[inline]
     pub fn add_generalized(&mut self, k: usize, value: f64) {
@@ -93,6 +157,13 @@ pub enum Crossing {
 pub trait ForceElement: Send + Sync {
     /// A name for messages and output.
     fn name(&self) -> &str;
+
+    /// Checks that the element fits `model` (the joints and frames it was built with are
+    /// there, at the same indices); `System::add_element` calls it. The default accepts any
+    /// model.
+    fn check_model(&self, _model: &Model) -> crate::Result<()> {
+        Ok(())
+    }
 
     /// Number of internal states.
     fn state_count(&self) -> usize {

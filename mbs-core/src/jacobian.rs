@@ -44,6 +44,7 @@ fn fill(
     angular: bool,
 ) -> Result<()> {
     let rows = if angular { 3 } else { 2 };
+    data.check(model)?;
     check_shape(model, out, rows)?;
     out.fill(0.0);
     let p = data.x_world[body.0].transform_point(p_b);
@@ -74,10 +75,10 @@ fn column(model: &Model, data: &Data, j: BodyId, p: [f64; 2]) -> (f64, [f64; 2])
 
 fn check_shape(model: &Model, out: &DMatrix<f64>, rows: usize) -> Result<()> {
     if out.nrows() != rows || out.ncols() != model.nv() {
-        return Err(CoreError::DimensionMismatch {
-            what: "jacobian (rows × cols)",
-            expected: rows * model.nv(),
-            got: out.nrows() * out.ncols(),
+        return Err(CoreError::ShapeMismatch {
+            what: "jacobian",
+            expected: (rows, model.nv()),
+            got: (out.nrows(), out.ncols()),
         });
     }
     Ok(())

@@ -8,6 +8,7 @@ use crate::spatial::{Motion, Transform};
 
 /// Computes the world pose of every body for configuration `q`.
 pub fn update_poses(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     kinematics_pass(model, data, q, None);
     Ok(())
@@ -15,6 +16,7 @@ pub fn update_poses(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
 
 /// Computes world poses and body velocities for `(q, v)`.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) -> Result<()> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     kinematics_pass(model, data, q, Some(v));
@@ -77,10 +79,11 @@ pub fn point_velocity(data: &Data, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
 
 /// World (classical) acceleration of the point `p_b` fixed to `body`, gravity excluded:
 /// `R (a + α × p + ω × (v + ω × p))`, with `(α, a)` the spatial acceleration. Needs
-/// [`forward_kinematics_acc`].
+/// accelerations: [`forward_kinematics_acc`], or a dynamics call (see
+/// [`Data::body_acceleration`]).
 pub fn point_acceleration(data: &Data, body: BodyId, p_b: [f64; 2]) -> [f64; 2] {
     let v = &data.v[body.0];
-    let a = &data.a[body.0];
+    let a = &data.body_acceleration(body);
     let vp = [v.vx - v.w * p_b[1], v.vy + v.w * p_b[0]];
     let acc = [
         a.vx - a.w * p_b[1] - v.w * vp[1],

@@ -220,10 +220,9 @@ impl Model {
         self.body_of_coordinate
             .get(k)
             .map(|&b| BodyId(b))
-            .ok_or(CoreError::DimensionMismatch {
+            .ok_or_else(|| CoreError::UnknownName {
                 what: "coordinate index",
-                expected: self.nv(),
-                got: k,
+                name: format!("{k} (the model has {} coordinates)", self.nv()),
             })
     }
 

@@ -29,6 +29,7 @@ pub fn rnea<'d>(
     v: &[f64],
     a: &[f64],
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("a", a, model.nv())?;
@@ -47,6 +48,7 @@ pub fn rnea_with_forces<'d>(
     a: &[f64],
     f_ext: &[Force],
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("a", a, model.nv())?;
@@ -63,6 +65,7 @@ pub fn nonlinear_effects<'d>(
     q: &[f64],
     v: &[f64],
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     rnea_pass(model, data, q, Some(v), None, None, Output::Nle);
@@ -76,6 +79,7 @@ pub fn gravity_torque<'d>(
     data: &'d mut Data,
     q: &[f64],
 ) -> Result<&'d DVector<f64>> {
+    data.check(model)?;
     check_input("q", q, model.nv())?;
     rnea_pass(model, data, q, None, None, None, Output::Gravity);
     Ok(&data.gravity)
@@ -90,7 +94,13 @@ pub(crate) fn check_forces(model: &Model, f_ext: &[Force]) -> Result<()> {
             got: f_ext.len(),
         });
     }
-    if let Some(index) = f_ext.iter().position(|f| !f.is_finite()) {
+    // Entry 0 (the ground) is ignored, so it may hold anything.
+    if let Some(index) = f_ext
+        .iter()
+        .skip(1)
+        .position(|f| !f.is_finite())
+        .map(|i| i + 1)
+    {
         let f = f_ext[index];
         let value = [f.n, f.fx, f.fy]
             .into_iter()
@@ -132,6 +142,7 @@ pub(crate) fn rnea_pass(
         let iv = b.idx_v;
         let x = b.joint_transform(q[iv]);
         data.x_up[i] = x;
+        data.x_world[i] = data.x_world[b.parent].compose(&x);
         let qd = v.map_or(0.0, |v| v[iv]);
         let qdd = a.map_or(0.0, |a| a[iv]);
         let vj = b.s * qd;

@@ -1,6 +1,7 @@
 //! [`System`]: a model plus force elements and prescribed coordinates, giving the state
 //! derivative of `x = [q, v, internal states]`.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use crate::aba::{Prescribed, articulated_pass};
@@ -19,8 +20,8 @@ use crate::time_function::{Drive, DriveState};
 /// gives `ẋ = [v, q̈, state rates]` with `q̈` from the articulated-body algorithm (hybrid
 /// dynamics when coordinates are prescribed).
 ///
-/// A `System` is immutable once built and cheap to clone (elements are shared); each thread
-/// evaluating it needs its own [`Workspace`].
+/// A `System` is cheap to clone (the model and the elements are shared, behind `Arc`);
+/// each thread evaluating it needs its own [`Workspace`].
 ///
 /// ```
 /// use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System};
@@ -31,7 +32,7 @@ use crate::time_function::{Drive, DriveState};
 /// let model = b.build().unwrap();
 /// let spring = JointSpringDamper::new(&model, "arm", SpringLaw::new(2.0, 0.0)).unwrap();
 /// let mut system = System::new(model);
-/// system.add_element(spring);
+/// system.add_element(spring).unwrap();
 /// let mut ws = system.workspace();
 /// let x = [0.1, 0.0];
 /// let mut xdot = [0.0; 2];
@@ -41,16 +42,21 @@ use crate::time_function::{Drive, DriveState};
 /// ```
 #[derive(Clone)]
 pub struct System {
-    model: Model,
-    elements: Vec<Arc<dyn ForceElement>>,
-    /// Start of each element's internal states in x.
-    state_offsets: Vec<usize>,
-    /// Start of each element's switching functions.
-    switch_offsets: Vec<usize>,
+    model: Arc<Model>,
+    entries: Vec<Entry>,
     state_len: usize,
     switch_len: usize,
     drives: Vec<Option<Arc<dyn Drive>>>,
     mask: Vec<bool>,
+}
+
+/// A force element with the ranges of its internal states (in x) and switching functions,
+/// fixed when it is added.
+#[derive(Clone)]
+struct Entry {
+    element: Arc<dyn ForceElement>,
+    states: Range<usize>,
+    switches: Range<usize>,
 }
 
 /// Per-thread scratch space for evaluating a [`System`]: allocated once by
@@ -75,12 +81,6 @@ impl Workspace {
     /// evaluation.
     pub fn data(&self) -> &Data {
         &self.data
-    }
-
-    /// Total generalized force of the force elements in the last evaluation, per
-    /// coordinate (forces on bodies mapped through the Jacobians: `τ + Σ Jᵀ f`).
-    pub fn element_forces(&self) -> &[f64] {
-        &self.element_tau
     }
 
     /// Generalized force each drive supplied in the last evaluation to make its coordinate
@@ -125,10 +125,8 @@ impl System {
         Self {
             state_len: 2 * nv,
             switch_len: 0,
-            model,
-            elements: Vec::new(),
-            state_offsets: Vec::new(),
-            switch_offsets: Vec::new(),
+            model: Arc::new(model),
+            entries: Vec::new(),
             drives: vec![None; nv],
             mask: vec![false; nv],
         }
@@ -139,24 +137,30 @@ impl System {
         &self.model
     }
 
-    /// Adds a force element; returns its index.
-    pub fn add_element(&mut self, element: impl ForceElement + 'static) -> usize {
+    /// Adds a force element; returns its index. Fails when the element was built for
+    /// another model (its joints or frames do not match this one).
+    pub fn add_element(&mut self, element: impl ForceElement + 'static) -> Result<usize> {
         self.add_shared_element(Arc::new(element))
     }
 
-    /// Adds a shared force element; returns its index.
-    pub fn add_shared_element(&mut self, element: Arc<dyn ForceElement>) -> usize {
-        self.state_offsets.push(self.state_len);
-        self.switch_offsets.push(self.switch_len);
-        self.state_len += element.state_count();
-        self.switch_len += element.switch_count();
-        self.elements.push(element);
-        self.elements.len() - 1
+    /// Adds a shared force element; returns its index (see [`System::add_element`]).
+    pub fn add_shared_element(&mut self, element: Arc<dyn ForceElement>) -> Result<usize> {
+        element.check_model(&self.model)?;
+        let states = self.state_len..self.state_len + element.state_count();
+        let switches = self.switch_len..self.switch_len + element.switch_count();
+        self.state_len = states.end;
+        self.switch_len = switches.end;
+        self.entries.push(Entry {
+            element,
+            states,
+            switches,
+        });
+        Ok(self.entries.len() - 1)
     }
 
     /// The force elements, in order.
-    pub fn elements(&self) -> &[Arc<dyn ForceElement>] {
-        &self.elements
+    pub fn elements(&self) -> impl ExactSizeIterator<Item = &dyn ForceElement> + '_ {
+        self.entries.iter().map(|e| e.element.as_ref())
     }
 
     /// Makes the joint named `joint` follow `drive`: its coordinate and velocity are taken
@@ -192,21 +196,20 @@ impl System {
         self.switch_len
     }
 
-    /// Range of element `e`'s internal states in the state vector.
-    pub fn element_state_range(&self, e: usize) -> std::ops::Range<usize> {
-        let start = self.state_offsets[e];
-        start..start + self.elements[e].state_count()
+    /// Range of element `e`'s internal states in the state vector (`None` if there is no
+    /// element `e`).
+    pub fn element_state_range(&self, e: usize) -> Option<Range<usize>> {
+        self.entries.get(e).map(|en| en.states.clone())
     }
 
     /// The element and local index of switching function `k`, and its crossing direction.
     pub fn switch_info(&self, k: usize) -> Option<(usize, usize, Crossing)> {
         let e = self
-            .switch_offsets
-            .partition_point(|&o| o <= k)
-            .checked_sub(1)?;
-        let local = k - self.switch_offsets[e];
-        (local < self.elements[e].switch_count())
-            .then(|| (e, local, self.elements[e].switch_direction(local)))
+            .entries
+            .iter()
+            .position(|en| en.switches.contains(&k))?;
+        let local = k - self.entries[e].switches.start;
+        Some((e, local, self.entries[e].element.switch_direction(local)))
     }
 
     /// A workspace for evaluating this system.
@@ -245,9 +248,9 @@ impl System {
                 x[nv + k] = s.v;
             }
         }
-        for (e, el) in self.elements.iter().enumerate() {
-            let r = self.element_state_range(e);
-            el.initial_states(&self.model, &mut x[r]);
+        for en in &self.entries {
+            en.element
+                .initial_states(&self.model, &mut x[en.states.clone()]);
         }
         Ok(x)
     }
@@ -272,13 +275,14 @@ impl System {
             format!("q of joint '{}'", self.model.joint_names[index])
         } else if index < 2 * nv {
             format!("v of joint '{}'", self.model.joint_names[index - nv])
-        } else {
-            let e = self.state_offsets.partition_point(|&o| o <= index) - 1;
+        } else if let Some(en) = self.entries.iter().find(|en| en.states.contains(&index)) {
             format!(
                 "internal state {} of {}",
-                index - self.state_offsets[e],
-                self.elements[e].name()
+                index - en.states.start,
+                en.element.name()
             )
+        } else {
+            format!("index {index} beyond the state length {}", self.state_len)
         }
     }
 
@@ -315,6 +319,12 @@ impl System {
 
     /// Loads q, v (drives applied) and runs kinematics.
     fn prepare(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<()> {
+        if ws.q.len() != self.model.nv() || ws.forces_world.len() != self.model.nbodies() {
+            return Err(CoreError::WorkspaceMismatch {
+                expected: self.model.nbodies(),
+                got: ws.forces_world.len(),
+            });
+        }
         self.check_state(t, x)?;
         let nv = self.model.nv();
         ws.q.copy_from_slice(&x[..nv]);
@@ -354,14 +364,11 @@ impl System {
         ws.tau.fill(0.0);
         ws.forces_world.fill(Force::ZERO);
         let (head, rates) = xdot.split_at_mut(2 * nv);
-        for (e, el) in self.elements.iter().enumerate() {
-            let r = self.element_state_range(e);
+        for en in &self.entries {
+            let r = en.states.clone();
             let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r.clone()]);
-            let mut loads = Loads {
-                tau: &mut ws.tau,
-                body_forces: &mut ws.forces_world,
-            };
-            el.apply(
+            let mut loads = Loads::new(&mut ws.tau, &mut ws.forces_world);
+            en.element.apply(
                 &ctx,
                 &mut loads,
                 &mut rates[r.start - 2 * nv..r.end - 2 * nv],
@@ -389,16 +396,8 @@ impl System {
             Some(&ws.forces_local),
             prescribed,
         );
-        // Element totals τ + Σ Jᵀ f, and what the drives had to add.
-        body_forces_to_generalized(
-            &self.model,
-            &ws.data,
-            &ws.forces_local,
-            &mut ws.scratch_forces,
-            &mut ws.element_tau,
-        );
+        // What the drives had to add to the elements' direct generalized forces.
         for k in 0..nv {
-            ws.element_tau[k] += ws.tau[k];
             ws.drive_tau[k] = if self.mask[k] {
                 ws.data.tau[k] - ws.tau[k]
             } else {
@@ -420,24 +419,20 @@ impl System {
     /// Re-evaluates the elements one at a time to name the one producing non-finite loads
     /// (cold path: only after a failure).
     fn find_bad_element(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> CoreError {
-        for (e, el) in self.elements.iter().enumerate() {
-            let r = self.element_state_range(e);
+        for en in &self.entries {
             ws.scratch_tau.fill(0.0);
             ws.scratch_forces.fill(Force::ZERO);
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r.clone()]);
-            let mut loads = Loads {
-                tau: &mut ws.scratch_tau,
-                body_forces: &mut ws.scratch_forces,
-            };
-            let mut rates = vec![0.0; r.len()];
-            el.apply(&ctx, &mut loads, &mut rates);
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[en.states.clone()]);
+            let mut loads = Loads::new(&mut ws.scratch_tau, &mut ws.scratch_forces);
+            let mut rates = vec![0.0; en.states.len()];
+            en.element.apply(&ctx, &mut loads, &mut rates);
             let bad = ws.scratch_tau.iter().any(|v| !v.is_finite())
                 || ws.scratch_forces.iter().any(|f| !f.is_finite())
                 || rates.iter().any(|v| !v.is_finite());
             if bad {
                 return CoreError::NonFiniteOutput {
                     t,
-                    source_name: el.name().to_string(),
+                    source_name: en.element.name().to_string(),
                     quantity: "load or state rate",
                 };
             }
@@ -447,6 +442,23 @@ impl System {
             source_name: "force elements".into(),
             quantity: "load or state rate",
         }
+    }
+
+    /// Total generalized force of the force elements in the last [`System::derivative`],
+    /// per coordinate: their direct generalized forces plus their forces on bodies mapped
+    /// through the Jacobians (`τ + Σ Jᵀ f`). Computed on request (one backward pass).
+    pub fn element_forces<'w>(&self, ws: &'w mut Workspace) -> &'w [f64] {
+        body_forces_to_generalized(
+            &self.model,
+            &ws.data,
+            &ws.forces_local,
+            &mut ws.scratch_forces,
+            &mut ws.element_tau,
+        );
+        for (e, t) in ws.element_tau.iter_mut().zip(&ws.tau) {
+            *e += t;
+        }
+        &ws.element_tau
     }
 
     /// Values of all switching functions at `(t, x)`, written into `out` (length
@@ -466,11 +478,19 @@ impl System {
             });
         }
         self.prepare(ws, t, x)?;
-        for (e, el) in self.elements.iter().enumerate() {
-            let r = self.element_state_range(e);
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r]);
-            let start = self.switch_offsets[e];
-            el.switching_functions(&ctx, &mut out[start..start + el.switch_count()]);
+        for en in &self.entries {
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[en.states.clone()]);
+            let out = &mut out[en.switches.clone()];
+            // Unwritten values show up as NaN rather than as the caller's stale numbers.
+            out.fill(f64::NAN);
+            en.element.switching_functions(&ctx, out);
+            if out.iter().any(|v| !v.is_finite()) {
+                return Err(CoreError::NonFiniteOutput {
+                    t,
+                    source_name: en.element.name().to_string(),
+                    quantity: "switching function",
+                });
+            }
         }
         Ok(())
     }
@@ -479,10 +499,17 @@ impl System {
     pub fn energy(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<Energy> {
         self.prepare(ws, t, x)?;
         let mut elastic = 0.0;
-        for (e, el) in self.elements.iter().enumerate() {
-            let r = self.element_state_range(e);
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r]);
-            elastic += el.potential_energy(&ctx);
+        for en in &self.entries {
+            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[en.states.clone()]);
+            let e = en.element.potential_energy(&ctx);
+            if !e.is_finite() {
+                return Err(CoreError::NonFiniteOutput {
+                    t,
+                    source_name: en.element.name().to_string(),
+                    quantity: "potential energy",
+                });
+            }
+            elastic += e;
         }
         Ok(Energy {
             kinetic: kinetic_energy_from_kinematics(&self.model, &ws.data),

@@ -1,8 +1,8 @@
 //! `System`: force elements, prescribed coordinates, internal states and errors.
 
 use mbs_core::elements::{
-    AppliedLoad, Attachment, JointSpringDamper, LoadFrame, PivotFriction, PointSpringDamper,
-    SpringLaw, Stribeck,
+    AppliedLoad, Attachment, FrictionLaw, JointSpringDamper, LoadFrame, PivotFriction,
+    PointSpringDamper, SpringLaw, Stribeck,
 };
 use mbs_core::time_function::{Constant, Sinusoid, SmoothMove};
 use mbs_core::{
@@ -64,28 +64,32 @@ fn springs_conserve_total_energy_and_dampers_dissipate_it() {
     let model = double_pendulum();
     for damping in [0.0, 0.05] {
         let mut system = System::new(model.clone());
-        system.add_element(
-            JointSpringDamper::new(
-                &model,
-                "lower",
-                SpringLaw::new(4.0, 0.3)
-                    .with_preload(0.2)
-                    .with_damping(damping),
+        system
+            .add_element(
+                JointSpringDamper::new(
+                    &model,
+                    "lower",
+                    SpringLaw::new(4.0, 0.3)
+                        .with_preload(0.2)
+                        .with_damping(damping),
+                )
+                .unwrap(),
             )
-            .unwrap(),
-        );
-        system.add_element(
-            PointSpringDamper::new(
-                &model,
-                "tether",
-                Attachment::on("lower", [0.4, 0.0]),
-                Attachment::ground([0.5, 0.2]),
-                SpringLaw::new(30.0, 0.2)
-                    .with_preload(1.0)
-                    .with_damping(damping),
+            .unwrap();
+        system
+            .add_element(
+                PointSpringDamper::new(
+                    &model,
+                    "tether",
+                    Attachment::on("lower", [0.4, 0.0]),
+                    Attachment::ground([0.5, 0.2]),
+                    SpringLaw::new(30.0, 0.2)
+                        .with_preload(1.0)
+                        .with_damping(damping),
+                )
+                .unwrap(),
             )
-            .unwrap(),
-        );
+            .unwrap();
         let mut ws = system.workspace();
         let mut x = system
             .initial_state(0.0, &[-1.2, 0.5], &[0.0, 1.0])
@@ -139,16 +143,18 @@ fn point_spring_acts_equally_and_oppositely_on_two_bodies() {
     );
     let model = b.build().unwrap();
     let mut system = System::new(model.clone());
-    system.add_element(
-        PointSpringDamper::new(
-            &model,
-            "s",
-            Attachment::on("a", [0.0, 0.0]),
-            Attachment::on("b", [0.0, 0.0]),
-            SpringLaw::new(100.0, 0.8),
+    system
+        .add_element(
+            PointSpringDamper::new(
+                &model,
+                "s",
+                Attachment::on("a", [0.0, 0.0]),
+                Attachment::on("b", [0.0, 0.0]),
+                SpringLaw::new(100.0, 0.8),
+            )
+            .unwrap(),
         )
-        .unwrap(),
-    );
+        .unwrap();
     let mut ws = system.workspace();
     let mut xdot = [0.0; 4];
     system
@@ -157,7 +163,7 @@ fn point_spring_acts_equally_and_oppositely_on_two_bodies() {
     // Length 1.1, rest 0.8: tension 30 N pulls a forward (+x) and b back.
     assert!((xdot[2] - 30.0).abs() < 1e-12);
     assert!((xdot[3] + 15.0).abs() < 1e-12);
-    let f = ws.element_forces();
+    let f = system.element_forces(&mut ws);
     assert!((f[0] + f[1]).abs() < 1e-12 && (f[0] - 30.0).abs() < 1e-12);
     assert_eq!(ws.drive_forces(), &[0.0, 0.0]);
 }
@@ -170,18 +176,22 @@ fn applied_force_equals_the_jacobian_transpose_map() {
     let dir_body = [0.6, -0.8];
     let mag = 2.5;
     let mut system = System::new(model.clone());
-    system.add_element(
-        AppliedLoad::force(
-            &model,
-            "push",
-            Attachment::on("lower", at),
-            dir_body,
-            LoadFrame::Body,
-            Constant(mag),
+    system
+        .add_element(
+            AppliedLoad::force(
+                &model,
+                "push",
+                Attachment::on("lower", at),
+                dir_body,
+                LoadFrame::Body,
+                Constant(mag),
+            )
+            .unwrap(),
         )
-        .unwrap(),
-    );
-    system.add_element(AppliedLoad::torque(&model, "twist", "upper", Constant(0.7)).unwrap());
+        .unwrap();
+    system
+        .add_element(AppliedLoad::torque(&model, "twist", "upper", Constant(0.7)).unwrap())
+        .unwrap();
     let (q, v) = ([0.4, -0.9], [0.3, -0.2]);
     let mut ws = system.workspace();
     let mut xdot = [0.0; 4];
@@ -201,25 +211,26 @@ fn applied_force_equals_the_jacobian_transpose_map() {
     tau[0] += 0.7;
     let qdd = aba(&model, &mut data, &q, &v, tau.as_slice()).unwrap();
     assert!((qdd[0] - xdot[2]).abs() < 1e-12 && (qdd[1] - xdot[3]).abs() < 1e-12);
-    assert!((ws.element_forces()[0] - tau[0]).abs() < 1e-12);
-    assert!((ws.element_forces()[1] - tau[1]).abs() < 1e-12);
+    assert!((system.element_forces(&mut ws)[0] - tau[0]).abs() < 1e-12);
+    assert!((system.element_forces(&mut ws)[1] - tau[1]).abs() < 1e-12);
 }
 
 #[test]
 fn pivot_friction_opposes_motion_with_a_stribeck_peak() {
     let model = double_pendulum();
-    let f = PivotFriction::new(
-        &model,
-        "upper",
-        0.01,
-        0.002,
-        1e-4,
+    let law = FrictionLaw::coulomb(0.01, 1e-4)
+        .with_viscous(0.002)
+        .with_stribeck(0.03, 0.05);
+    let f = PivotFriction::new(&model, "upper", law)
+        .unwrap()
+        .with_reversal_events();
+    assert_eq!(
+        law.stribeck,
         Some(Stribeck {
             static_torque: 0.03,
-            velocity: 0.05,
-        }),
-    )
-    .unwrap();
+            velocity: 0.05
+        })
+    );
     assert_eq!(f.torque(0.0), 0.0);
     assert!(f.torque(1.0) < 0.0 && f.torque(-1.0) > 0.0);
     // Just past the regularisation the breakaway level shows; far above, Coulomb + viscous.
@@ -228,7 +239,7 @@ fn pivot_friction_opposes_motion_with_a_stribeck_peak() {
     assert!(f.torque(-2.0) == -f.torque(2.0));
     // Its switching function is the joint velocity.
     let mut system = System::new(model);
-    system.add_element(f);
+    system.add_element(f).unwrap();
     let mut ws = system.workspace();
     let mut s = [0.0];
     system
@@ -305,13 +316,13 @@ fn prescribed_cart_returns_the_driving_force() {
     }
     // A spring on the driven cart helps the drive: the drive supplies only the rest.
     let spring = JointSpringDamper::new(system.model(), "cart", SpringLaw::new(40.0, 0.0)).unwrap();
-    system.add_element(spring.clone());
+    system.add_element(spring.clone()).unwrap();
     let mut ws = system.workspace();
     let mut xdot = [0.0; 4];
     system
         .derivative(&mut ws, 0.9, &[0.0, 0.3, 0.0, 0.5], &mut xdot)
         .unwrap();
-    let total = ws.drive_forces()[0] + ws.element_forces()[0];
+    let total = ws.drive_forces()[0] + system.element_forces(&mut ws)[0];
     let without = {
         let mut bare = System::new(system.model().clone());
         bare.prescribe("cart", drive).unwrap();
@@ -321,7 +332,7 @@ fn prescribed_cart_returns_the_driving_force() {
         w.drive_forces()[0]
     };
     let d = mbs_core::Drive::eval(&drive, 0.9);
-    assert!((ws.element_forces()[0] - spring.force(d.q, d.v)).abs() < 1e-12);
+    assert!((system.element_forces(&mut ws)[0] - spring.force(d.q, d.v)).abs() < 1e-12);
     assert!(
         (total - without).abs() < 1e-12,
         "drive + spring = bare drive force"
@@ -379,22 +390,35 @@ impl ForceElement for Lag {
 fn internal_states_are_initialised_integrated_and_named() {
     let model = double_pendulum();
     let mut system = System::new(model.clone());
-    system.add_element(PivotFriction::new(&model, "lower", 0.0, 0.01, 1e-3, None).unwrap());
-    let e = system.add_element(Lag { time_constant: 0.5 });
+    system
+        .add_element(
+            PivotFriction::new(
+                &model,
+                "lower",
+                FrictionLaw::coulomb(0.0, 1e-3).with_viscous(0.01),
+            )
+            .unwrap()
+            .with_reversal_events(),
+        )
+        .unwrap();
+    let e = system.add_element(Lag { time_constant: 0.5 }).unwrap();
     assert_eq!(system.state_len(), 5);
-    assert_eq!(system.element_state_range(e), 4..5);
+    assert_eq!(system.element_state_range(e), Some(4..5));
+    assert_eq!(system.element_state_range(9), None);
     let x = system.initial_state(0.0, &[1.0, 0.0], &[0.0, 0.0]).unwrap();
     assert_eq!(x[4], 0.25);
     let mut ws = system.workspace();
     let mut xdot = [0.0; 5];
     system.derivative(&mut ws, 0.0, &x, &mut xdot).unwrap();
     assert!((xdot[4] - (1.0 - 0.25) / 0.5).abs() < 1e-15);
-    assert_eq!(ws.element_forces()[0], -0.25);
+    assert_eq!(system.element_forces(&mut ws)[0], -0.25);
     assert_eq!(system.switch_len(), 3);
     assert_eq!(system.switch_info(1), Some((1, 0, Crossing::Rising)));
     assert_eq!(system.switch_info(2), Some((1, 1, Crossing::Falling)));
     assert!(system.state_meaning(4).contains("lag"));
     assert!(system.state_meaning(3).contains("v of joint 'lower'"));
+    assert!(system.state_meaning(99).contains("beyond"));
+    assert!(System::new(model).state_meaning(7).contains("beyond"));
 }
 
 struct Broken;
@@ -414,7 +438,7 @@ impl ForceElement for Broken {
 fn bad_states_elements_and_drives_are_named() {
     let model = double_pendulum();
     let mut system = System::new(model.clone());
-    system.add_element(Broken);
+    system.add_element(Broken).unwrap();
     let mut ws = system.workspace();
     let mut xdot = [0.0; 4];
     let e = system
@@ -464,7 +488,7 @@ fn bad_states_elements_and_drives_are_named() {
     // Element parameters are validated at construction, naming the field.
     let e = JointSpringDamper::new(&model, "upper", SpringLaw::new(-1.0, 0.0)).unwrap_err();
     assert!(e.to_string().contains("stiffness"), "{e}");
-    let e = PivotFriction::new(&model, "upper", 0.1, 0.0, 0.0, None).unwrap_err();
+    let e = PivotFriction::new(&model, "upper", FrictionLaw::coulomb(0.1, 0.0)).unwrap_err();
     assert!(e.to_string().contains("regularization"), "{e}");
     let e = PointSpringDamper::new(
         &model,
@@ -475,4 +499,171 @@ fn bad_states_elements_and_drives_are_named() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("nowhere"), "{e}");
+}
+
+#[test]
+fn elements_workspaces_and_loads_that_cannot_work_are_refused() {
+    let model = double_pendulum();
+    let chain = mbs_core::benchmarks::planar_chain(3);
+    // An element built on another model is refused, whether its joint is missing here...
+    let spring = JointSpringDamper::new(&chain, "link3", SpringLaw::new(1.0, 0.0)).unwrap();
+    let mut system = System::new(model.clone());
+    let e = system.add_element(spring).unwrap_err();
+    assert!(e.to_string().contains("another model"), "{e}");
+    // ...or present under another index.
+    let mut b = ModelBuilder::new();
+    b.add_link(
+        "lower",
+        None,
+        JointKind::Revolute,
+        Placement::default(),
+        BodySpec::rod(1.0, 1.0),
+    )
+    .add_link(
+        "upper",
+        Some("lower"),
+        JointKind::Revolute,
+        Placement::offset(1.0, 0.0),
+        BodySpec::rod(1.0, 1.0),
+    );
+    let swapped = b.build().unwrap();
+    let friction = PivotFriction::new(&swapped, "upper", FrictionLaw::coulomb(0.1, 1e-3)).unwrap();
+    assert!(system.add_element(friction).is_err());
+    let load = AppliedLoad::torque(&swapped, "t", "upper", Constant(1.0)).unwrap();
+    assert!(system.add_element(load).is_err());
+    // Loads on the ground act on nothing: refused when built.
+    let e = AppliedLoad::force(
+        &model,
+        "p",
+        Attachment::ground([0.0, 0.0]),
+        [1.0, 0.0],
+        LoadFrame::World,
+        Constant(1.0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("ground"), "{e}");
+    let mut b = ModelBuilder::new();
+    b.add_link(
+        "base",
+        None,
+        JointKind::Fixed,
+        Placement::default(),
+        BodySpec::rod(1.0, 1.0),
+    )
+    .add_link(
+        "arm",
+        Some("base"),
+        JointKind::Revolute,
+        Placement::default(),
+        BodySpec::rod(1.0, 1.0),
+    );
+    let based = b.build().unwrap();
+    assert!(AppliedLoad::torque(&based, "t", "base", Constant(1.0)).is_err());
+    assert!(AppliedLoad::torque(&based, "t", "arm", Constant(1.0)).is_ok());
+    let e = PointSpringDamper::new(
+        &based,
+        "s",
+        Attachment::on("base", [0.0, 0.0]),
+        Attachment::ground([1.0, 0.0]),
+        SpringLaw::new(1.0, 0.0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("both ends"), "{e}");
+    // A workspace of another system is refused, as is a Data of another model.
+    let other = System::new(chain.clone());
+    let mut ws = other.workspace();
+    let e = system
+        .derivative(&mut ws, 0.0, &[0.0; 4], &mut [0.0; 4])
+        .unwrap_err();
+    assert!(matches!(e, CoreError::WorkspaceMismatch { .. }), "{e:?}");
+    let mut data = Data::new(&chain);
+    let e = aba(&model, &mut data, &[0.0; 2], &[0.0; 2], &[0.0; 2]).unwrap_err();
+    assert!(matches!(e, CoreError::WorkspaceMismatch { .. }), "{e:?}");
+}
+
+/// An element whose switching function is undefined somewhere.
+struct BadSwitch;
+
+impl ForceElement for BadSwitch {
+    fn name(&self) -> &str {
+        "bad switch"
+    }
+    fn apply(&self, _ctx: &ForceContext<'_>, _loads: &mut Loads<'_>, _rates: &mut [f64]) {}
+    fn switch_count(&self) -> usize {
+        2
+    }
+    fn switching_functions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
+        // Forgets out[1]; out[0] is NaN for negative angles.
+        out[0] = ctx.q[0].sqrt();
+    }
+    fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
+        ctx.q[1].ln()
+    }
+}
+
+#[test]
+fn switching_functions_and_energies_are_checked() {
+    let mut system = System::new(double_pendulum());
+    system.add_element(BadSwitch).unwrap();
+    let mut ws = system.workspace();
+    let mut out = [7.0, 7.0];
+    let e = system
+        .switching_functions(&mut ws, 0.0, &[1.0, 1.0, 0.0, 0.0], &mut out)
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("bad switch") && e.to_string().contains("switching"),
+        "{e}"
+    );
+    let e = system
+        .energy(&mut ws, 0.0, &[1.0, -1.0, 0.0, 0.0])
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("bad switch") && e.to_string().contains("energy"),
+        "{e}"
+    );
+}
+
+#[test]
+fn poses_and_accelerations_are_valid_after_the_dynamics_calls() {
+    // Regression (review): aba/rnea left world poses stale, and body accelerations carried
+    // the −g of the base.
+    let model = double_pendulum();
+    let (q, v, tau) = ([0.7, -0.4], [1.5, -2.0], [0.3, 0.1]);
+    let mut data = Data::new(&model);
+    let qdd = aba(&model, &mut data, &q, &v, &tau).unwrap().clone();
+    let lower = model.body_id("lower").unwrap();
+    let (pose, vel, acc) = (
+        data.body_pose(lower),
+        mbs_core::point_velocity(&data, lower, [0.4, 0.0]),
+        mbs_core::point_acceleration(&data, lower, [0.4, 0.0]),
+    );
+    let mut reference = Data::new(&model);
+    mbs_core::forward_kinematics_acc(&model, &mut reference, &q, &v, qdd.as_slice()).unwrap();
+    assert_eq!(pose, reference.body_pose(lower));
+    let rv = mbs_core::point_velocity(&reference, lower, [0.4, 0.0]);
+    let ra = mbs_core::point_acceleration(&reference, lower, [0.4, 0.0]);
+    for k in 0..2 {
+        assert!((vel[k] - rv[k]).abs() < 1e-12);
+        assert!((acc[k] - ra[k]).abs() < 1e-12, "{acc:?} vs {ra:?}");
+    }
+    // The same after rnea at that acceleration, and through a System (free slider falls at g).
+    mbs_core::rnea(&model, &mut data, &q, &v, qdd.as_slice()).unwrap();
+    let a2 = mbs_core::point_acceleration(&data, lower, [0.4, 0.0]);
+    assert!((a2[0] - ra[0]).abs() < 1e-12 && (a2[1] - ra[1]).abs() < 1e-12);
+    let mut b = ModelBuilder::new();
+    b.gravity([0.0, -9.81]).add_link(
+        "slider",
+        None,
+        JointKind::Prismatic { axis: [0.0, 1.0] },
+        Placement::default(),
+        BodySpec::new(1.0, [0.0, 0.0], 0.1),
+    );
+    let system = System::new(b.build().unwrap());
+    let mut ws = system.workspace();
+    system
+        .derivative(&mut ws, 0.0, &[0.0, 0.0], &mut [0.0; 2])
+        .unwrap();
+    let body = system.model().body_id("slider").unwrap();
+    let a = mbs_core::point_acceleration(ws.data(), body, [0.0, 0.0]);
+    assert!((a[1] + 9.81).abs() < 1e-12 && a[0].abs() < 1e-12, "{a:?}");
 }
