@@ -87,6 +87,13 @@ struct BodyDecl {
 }
 
 #[derive(Clone, Debug)]
+struct FrameDecl {
+    name: String,
+    parent: Option<String>,
+    placement: Placement,
+}
+
+#[derive(Clone, Debug)]
 struct JointDecl {
     name: String,
     kind: JointKind,
@@ -113,6 +120,7 @@ pub struct ModelBuilder {
     gravity: [f64; 2],
     bodies: Vec<BodyDecl>,
     joints: Vec<JointDecl>,
+    frames: Vec<FrameDecl>,
 }
 
 impl ModelBuilder {
@@ -171,17 +179,73 @@ impl ModelBuilder {
         self.add_joint(name, kind, parent, name, placement)
     }
 
+    /// Declares a massless named frame fixed to `parent` (a body or an earlier frame; `None`
+    /// for the ground), placed by `placement` in the parent's frame: a marker for contact
+    /// points, screws, rails and sensors that does not change the dynamics.
+    pub fn add_frame(
+        &mut self,
+        name: &str,
+        parent: Option<&str>,
+        placement: Placement,
+    ) -> &mut Self {
+        self.frames.push(FrameDecl {
+            name: name.to_string(),
+            parent: parent.map(str::to_string),
+            placement,
+        });
+        self
+    }
+
     /// Validates the declarations and builds the model.
     ///
     /// Errors, in the order they are checked: non-finite gravity; per body non-finite
     /// numbers, non-positive mass or inertia, duplicate names; per joint non-finite
     /// placement, bad prismatic axis, duplicate names, unknown parent or child; a body with
-    /// several parent joints; cycles; bodies not connected to the ground; an empty model.
+    /// several parent joints; cycles; bodies not connected to the ground; an empty model;
+    /// frames with non-finite placement, a name already used, or an unknown parent.
     pub fn build(&self) -> Result<Model> {
         self.validate_numbers()?;
         let (graph, nodes) = self.graph()?;
         let order = self.topological_order(&graph, &nodes)?;
-        Ok(self.assemble(&graph, &order))
+        let mut model = self.assemble(&graph, &order);
+        self.add_marker_frames(&mut model)?;
+        Ok(model)
+    }
+
+    /// Appends the massless frames, each placed relative to a body or an earlier frame.
+    fn add_marker_frames(&self, model: &mut Model) -> Result<()> {
+        for f in &self.frames {
+            let item = || format!("frame '{}'", f.name);
+            finite(item(), "placement.angle", f.placement.angle)?;
+            finite(item(), "placement.x", f.placement.x)?;
+            finite(item(), "placement.y", f.placement.y)?;
+            if model.frame_by_name.contains_key(&f.name) {
+                return Err(CoreError::DuplicateName {
+                    what: "frame",
+                    name: f.name.clone(),
+                });
+            }
+            let (body, base) = match &f.parent {
+                None => (crate::BodyId::GROUND, Transform::IDENTITY),
+                Some(p) => {
+                    let id = model.frame_id(p).map_err(|_| CoreError::InvalidParameter {
+                        item: item(),
+                        message: format!("unknown parent '{p}' (not a body or an earlier frame)"),
+                    })?;
+                    let parent = model.frame(id);
+                    (parent.body, parent.placement)
+                }
+            };
+            model
+                .frame_by_name
+                .insert(f.name.clone(), model.frames.len());
+            model.frames.push(Frame {
+                name: f.name.clone(),
+                body,
+                placement: base.compose(&f.placement.transform()),
+            });
+        }
+        Ok(())
     }
 
     fn validate_numbers(&self) -> Result<()> {

@@ -137,6 +137,13 @@ impl Data {
         Motion::new(a.w, a.vx - g_b[0], a.vy - g_b[1])
     }
 
+    /// The spatial force on `body`, in its frame (the form `f_ext` of [`crate::rnea_with_forces`]
+    /// and [`crate::aba_with_forces`] takes), of a force `f_w` applied at the world point
+    /// `p_w`, both in world coordinates. Uses the body's current pose.
+    pub fn body_force_from_world(&self, body: BodyId, p_w: [f64; 2], f_w: [f64; 2]) -> Force {
+        self.x_world[body.0].apply_force(&Force::at_point(p_w, f_w))
+    }
+
     /// The spatial force each joint transmits from the parent to the body (the body
     /// frame's origin, body coordinates), from the last [`crate::rnea`]: joint reaction
     /// plus actuation. Its component along the joint's axis is the generalized force.

@@ -595,3 +595,34 @@ fn bad_inputs_give_named_errors() {
     let body = model.body_id("link2").unwrap();
     assert!(point_jacobian(&model, &data, body, [0.0, 0.0], &mut jac).is_err());
 }
+
+#[test]
+fn external_forces_enter_as_minus_jacobian_transpose() {
+    // RNEA with a world force F at a body point equals RNEA without it minus Jᵀ F; ABA with
+    // it undoes that.
+    for (name, model) in models() {
+        let n = model.nv();
+        let mut data = Data::new(&model);
+        let q = pseudo_random(21, n, -PI, PI);
+        let v = pseudo_random(22, n, -2.0, 2.0);
+        let a = pseudo_random(23, n, -5.0, 5.0);
+        let body = model.moving_bodies().nth(n / 2).unwrap();
+        let (p_b, f_w) = ([0.2, -0.1], [3.0, -1.5]);
+        update_poses(&model, &mut data, &q).unwrap();
+        let p_w = point_position(&data, body, p_b);
+        let mut fext = vec![mbs_core::Force::ZERO; model.nbodies()];
+        fext[body.index()] = data.body_force_from_world(body, p_w, f_w);
+        let mut jac = DMatrix::zeros(2, n);
+        point_jacobian(&model, &data, body, p_b, &mut jac).unwrap();
+        let jt_f = jac.transpose() * DVector::from_column_slice(&f_w);
+        let plain = rnea(&model, &mut data, &q, &v, &a).unwrap().clone();
+        let with = mbs_core::rnea_with_forces(&model, &mut data, &q, &v, &a, &fext)
+            .unwrap()
+            .clone();
+        let d = max_abs_diff(with.as_slice(), (plain - &jt_f).as_slice());
+        assert!(d < 1e-12, "{name}: {d:e}");
+        let qdd =
+            mbs_core::aba_with_forces(&model, &mut data, &q, &v, with.as_slice(), &fext).unwrap();
+        assert!(max_abs_diff(qdd.as_slice(), &a) < 1e-12, "{name}");
+    }
+}

@@ -929,3 +929,93 @@ fn wrong_type_in_json_names_the_field_path() {
     let e = Model::from_json_str(json).unwrap_err();
     assert!(e.to_string().contains("joints[0].body.mass"), "{e}");
 }
+
+#[test]
+fn massless_frames_mark_points_without_changing_the_dynamics() {
+    let build = |with_frames: bool| {
+        let mut b = ModelBuilder::new();
+        b.gravity([0.0, -9.81])
+            .add_link(
+                "arm",
+                None,
+                JointKind::Revolute,
+                Placement::default(),
+                BodySpec::rod(1.0, 1.0),
+            )
+            .add_link(
+                "hand",
+                Some("arm"),
+                JointKind::Revolute,
+                Placement::offset(1.0, 0.0),
+                BodySpec::rod(0.5, 0.5),
+            );
+        if with_frames {
+            b.add_frame("tip", Some("hand"), Placement::new(0.5, 0.5, 0.0))
+                .add_frame("nail", Some("tip"), Placement::offset(0.1, 0.0))
+                .add_frame("rail", None, Placement::offset(2.0, -1.0));
+        }
+        b.build().unwrap()
+    };
+    let (plain, marked) = (build(false), build(true));
+    let q = [0.3, -0.8];
+    let mut d1 = Data::new(&plain);
+    let mut d2 = Data::new(&marked);
+    assert_eq!(
+        crba(&plain, &mut d1, &q).unwrap(),
+        crba(&marked, &mut d2, &q).unwrap()
+    );
+    update_poses(&marked, &mut d2, &q).unwrap();
+    // nail = hand ∘ (rotate 0.5 about (0.5, 0)) ∘ (0.1, 0)
+    let nail = frame_pose(&marked, &d2, marked.frame_id("nail").unwrap());
+    let hand = d2.body_pose(marked.body_id("hand").unwrap());
+    let expect = hand.transform_point([0.5 + 0.1 * 0.5f64.cos(), 0.1 * 0.5f64.sin()]);
+    assert!((nail.x - expect[0]).abs() < 1e-14 && (nail.y - expect[1]).abs() < 1e-14);
+    assert!((nail.angle() - (hand.angle() + 0.5)).abs() < 1e-14);
+    let rail = marked.frame(marked.frame_id("rail").unwrap());
+    assert_eq!(rail.body, mbs_core::BodyId::GROUND);
+    // Errors name the frame.
+    let mut b = ModelBuilder::new();
+    b.add_link(
+        "arm",
+        None,
+        JointKind::Revolute,
+        Placement::default(),
+        BodySpec::rod(1.0, 1.0),
+    );
+    let e = b
+        .clone()
+        .add_frame("arm", None, Placement::default())
+        .build()
+        .unwrap_err();
+    assert_eq!(
+        e,
+        CoreError::DuplicateName {
+            what: "frame",
+            name: "arm".into()
+        }
+    );
+    let e = b
+        .clone()
+        .add_frame("tip", Some("leg"), Placement::default())
+        .build()
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("frame 'tip'") && e.to_string().contains("leg"),
+        "{e}"
+    );
+    let e = b
+        .clone()
+        .add_frame("tip", None, Placement::offset(f64::NAN, 0.0))
+        .build()
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            CoreError::NonFinite {
+                field: "placement.x",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+}
