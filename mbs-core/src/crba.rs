@@ -78,7 +78,8 @@ pub fn forward_dynamics_crba<'d>(
         check_forces(model, f)?;
     }
     crba_pass(model, data, q);
-    rnea_pass(model, data, q, Some(v), None, f_ext, Output::Nle);
+    // The CRBA pass has just set the joint transforms and poses for q.
+    rnea_pass(model, data, None, Some(v), None, f_ext, Output::Nle);
     factor_mass_matrix(model, data)?;
     let bodies = &model.bodies;
     for i in 1..bodies.len() {

@@ -33,7 +33,7 @@ pub fn rnea<'d>(
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("a", a, model.nv())?;
-    rnea_pass(model, data, q, Some(v), Some(a), None, Output::Tau);
+    rnea_pass(model, data, Some(q), Some(v), Some(a), None, Output::Tau);
     Ok(&data.tau)
 }
 
@@ -53,7 +53,15 @@ pub fn rnea_with_forces<'d>(
     check_input("v", v, model.nv())?;
     check_input("a", a, model.nv())?;
     check_forces(model, f_ext)?;
-    rnea_pass(model, data, q, Some(v), Some(a), Some(f_ext), Output::Tau);
+    rnea_pass(
+        model,
+        data,
+        Some(q),
+        Some(v),
+        Some(a),
+        Some(f_ext),
+        Output::Tau,
+    );
     Ok(&data.tau)
 }
 
@@ -68,7 +76,7 @@ pub fn nonlinear_effects<'d>(
     data.check(model)?;
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
-    rnea_pass(model, data, q, Some(v), None, None, Output::Nle);
+    rnea_pass(model, data, Some(q), Some(v), None, None, Output::Nle);
     Ok(&data.nle)
 }
 
@@ -81,7 +89,7 @@ pub fn gravity_torque<'d>(
 ) -> Result<&'d DVector<f64>> {
     data.check(model)?;
     check_input("q", q, model.nv())?;
-    rnea_pass(model, data, q, None, None, None, Output::Gravity);
+    rnea_pass(model, data, Some(q), None, None, None, Output::Gravity);
     Ok(&data.gravity)
 }
 
@@ -123,11 +131,12 @@ pub(crate) enum Output {
     Gravity,
 }
 
-/// RNEA proper; `None` velocity or acceleration means zero.
+/// RNEA proper; `None` velocity or acceleration means zero; `None` configuration means the
+/// joint transforms and poses in `data` are already those of the configuration.
 pub(crate) fn rnea_pass(
     model: &Model,
     data: &mut Data,
-    q: &[f64],
+    q: Option<&[f64]>,
     v: Option<&[f64]>,
     a: Option<&[f64]>,
     f_ext: Option<&[Force]>,
@@ -140,9 +149,15 @@ pub(crate) fn rnea_pass(
     for i in 1..bodies.len() {
         let b = &bodies[i];
         let iv = b.idx_v;
-        let x = b.joint_transform(q[iv]);
-        data.x_up[i] = x;
-        data.x_world[i] = data.x_world[b.parent].compose(&x);
+        let x = match q {
+            Some(q) => {
+                let x = b.joint_transform(q[iv]);
+                data.x_up[i] = x;
+                data.x_world[i] = data.x_world[b.parent].compose(&x);
+                x
+            }
+            None => data.x_up[i],
+        };
         let qd = v.map_or(0.0, |v| v[iv]);
         let qdd = a.map_or(0.0, |a| a[iv]);
         let vj = b.s * qd;
