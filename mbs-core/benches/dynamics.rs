@@ -7,13 +7,8 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use mbs_core::benchmarks::{branching_tree, planar_chain};
-use mbs_core::elements::{
-    AppliedLoad, Attachment, FrictionLaw, JointSpringDamper, LoadFrame, PivotFriction,
-    PointSpringDamper, SpringLaw,
-};
-use mbs_core::time_function::{Constant, SmoothMove};
-use mbs_core::{Data, Model, System, aba, crba, forward_dynamics_crba, rnea};
+use mbs_core::benchmarks::{branching_tree, branching_tree_system, planar_chain};
+use mbs_core::{Data, Model, aba, crba, forward_dynamics_crba, rnea};
 
 /// The state of the reference file for the chain; a deterministic spread for the tree.
 fn state(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -103,63 +98,18 @@ fn bench_model(c: &mut Criterion, name: &str, model: &Model) {
     group.finish();
 }
 
-/// The path integrators take: `System::derivative` on the 13-body tree with a joint
-/// spring, a point spring to the ground, pivot friction on every joint, an applied force and
-/// a prescribed coordinate.
+/// The path integrators take: `System::derivative` on the 13-body tree with one of every
+/// force element and a prescribed coordinate (`benchmarks::branching_tree_system`).
 fn bench_system(c: &mut Criterion) {
-    let model = branching_tree();
-    let mut system = System::new(model.clone());
-    system
-        .add_element(
-            JointSpringDamper::new(
-                &model,
-                "branch1",
-                SpringLaw::new(3.0, 0.1).with_damping(0.2),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-    system
-        .add_element(
-            PointSpringDamper::new(
-                &model,
-                "tether",
-                Attachment::on("twig02", [0.1, 0.0]),
-                Attachment::ground([1.0, 1.0]),
-                SpringLaw::new(50.0, 0.3).with_damping(1.0),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-    for joint in model.coordinate_names().to_vec() {
-        let law = FrictionLaw::coulomb(0.01, 1e-3).with_viscous(0.001);
-        system
-            .add_element(PivotFriction::new(&model, &joint, law).unwrap())
-            .unwrap();
-    }
-    system
-        .add_element(
-            AppliedLoad::force(
-                &model,
-                "push",
-                Attachment::on("twig11", [0.2, 0.0]),
-                [0.0, -1.0],
-                LoadFrame::Body,
-                Constant(2.0),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-    system
-        .prescribe("trunk", SmoothMove::new(0.0, 0.0, 0.5, 0.3).unwrap())
-        .unwrap();
+    let system = branching_tree_system().unwrap();
+    let model = system.model().clone();
     let mut ws = system.workspace();
     let n = model.nv();
     let q: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
     let v: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
     let x = system.initial_state(0.0, &q, &v).unwrap();
     let mut xdot = vec![0.0; system.state_len()];
-    c.bench_function("tree13/system_derivative_18_elements", |b| {
+    c.bench_function("tree13/system_derivative_17_elements", |b| {
         b.iter(|| {
             system
                 .derivative(&mut ws, black_box(0.2), black_box(&x), &mut xdot)

@@ -6,6 +6,7 @@ use nalgebra::DVector;
 
 use crate::data::Data;
 use crate::error::{CoreError, Result, check_input};
+use crate::kinematics::kinematics_pass;
 use crate::model::Model;
 use crate::rnea::check_forces;
 use crate::spatial::{ArticulatedInertia, Force, Motion};
@@ -36,7 +37,7 @@ pub fn aba<'d>(
     check_input("q", q, model.nv())?;
     check_input("v", v, model.nv())?;
     check_input("tau", tau, model.nv())?;
-    velocity_pass(model, data, q, v);
+    kinematics_pass(model, data, q, Some(v));
     articulated_pass(model, data, v, tau, None, None);
     Ok(&data.qdd)
 }
@@ -56,7 +57,7 @@ pub fn aba_with_forces<'d>(
     check_input("v", v, model.nv())?;
     check_input("tau", tau, model.nv())?;
     check_forces(model, f_ext)?;
-    velocity_pass(model, data, q, v);
+    kinematics_pass(model, data, q, Some(v));
     articulated_pass(model, data, v, tau, Some(f_ext), None);
     Ok(&data.qdd)
 }
@@ -104,7 +105,7 @@ pub fn hybrid_dynamics(
     if let Some(f) = f_ext {
         check_forces(model, f)?;
     }
-    velocity_pass(model, data, q, v);
+    kinematics_pass(model, data, q, Some(v));
     articulated_pass(model, data, v, tau, f_ext, Some(prescribed));
     Ok(())
 }
@@ -124,18 +125,6 @@ fn check_masked(what: &'static str, x: &[f64], n: usize, mask: &[bool], want: bo
         }
     }
     Ok(())
-}
-
-/// Joint transforms, world poses and body velocities.
-fn velocity_pass(model: &Model, data: &mut Data, q: &[f64], v: &[f64]) {
-    data.v[0] = Motion::ZERO;
-    for i in 1..model.bodies.len() {
-        let b = &model.bodies[i];
-        let x = b.joint_transform(q[b.idx_v]);
-        data.x_up[i] = x;
-        data.x_world[i] = data.x_world[b.parent].compose(&x);
-        data.v[i] = x.apply_motion(&data.v[b.parent]) + b.s * v[b.idx_v];
-    }
 }
 
 /// The articulated-body passes, given `data.x_up` and `data.v` for the current `(q, v)`.

@@ -2,7 +2,14 @@
 //! of Drake's `multibody/benchmarks`).
 
 use crate::builder::{BodySpec, JointKind, ModelBuilder, Placement};
+use crate::elements::{
+    AppliedLoad, Attachment, FrictionLaw, JointSpringDamper, LoadFrame, PivotFriction,
+    PointSpringDamper, SpringLaw,
+};
+use crate::error::Result;
 use crate::model::Model;
+use crate::system::System;
+use crate::time_function::{PiecewiseLinear, SmoothMove};
 
 /// Featherstone's `planar(n)` chain (spatial_v2): `n` unit links of 1 kg along their x axes,
 /// centre of mass at mid-link, inertia 1/12 kg·m² about it, revolute joints at the link
@@ -73,6 +80,48 @@ pub fn branching_tree() -> Model {
         .unwrap_or_else(|e| unreachable!("branching_tree is valid: {e}"))
 }
 
+/// The [`branching_tree`] with one of every standard force element and a prescribed
+/// coordinate: a preloaded joint spring–damper, a point spring–damper to the ground, pivot
+/// friction (with a Stribeck peak and reversal events) on every joint, a force that follows a
+/// table and turns with its body, a torque given by a closure, and a smooth prescribed move
+/// of one twig. The workload of an integrator step, for benchmarks and allocation tests.
+pub fn branching_tree_system() -> Result<System> {
+    let model = branching_tree();
+    let mut system = System::new(model.clone());
+    let spring = SpringLaw::new(3.0, 0.1).with_damping(0.2).with_preload(0.5);
+    system.add_element(JointSpringDamper::new(&model, "branch1", spring)?)?;
+    system.add_element(PointSpringDamper::new(
+        &model,
+        "tether",
+        Attachment::on("twig02", [0.1, 0.0]),
+        Attachment::ground([1.0, 1.0]),
+        SpringLaw::new(50.0, 0.3).with_damping(1.0),
+    )?)?;
+    let friction = FrictionLaw::coulomb(0.01, 1e-3)
+        .with_viscous(0.001)
+        .with_stribeck(0.02, 0.1);
+    for joint in model.coordinate_names() {
+        system.add_element(PivotFriction::new(&model, joint, friction)?.with_reversal_events())?;
+    }
+    let push = PiecewiseLinear::new(vec![(0.0, 0.0), (0.1, 5.0), (0.2, 0.0)])?;
+    system.add_element(AppliedLoad::force(
+        &model,
+        "push",
+        Attachment::on("twig11", [0.2, 0.0]),
+        [0.0, -1.0],
+        LoadFrame::Body,
+        push,
+    )?)?;
+    system.add_element(AppliedLoad::torque(
+        &model,
+        "twist",
+        "branch2",
+        |t: f64| t.sin(),
+    )?)?;
+    system.prescribe("twig21", SmoothMove::new(0.0, 0.0, 0.5, 0.3)?)?;
+    Ok(system)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -86,5 +135,8 @@ mod tests {
         // Depth: trunk → branch → twig.
         let twig = t.body_id("twig21").unwrap();
         assert_eq!(t.support(twig).count(), 3);
+        let s = branching_tree_system().unwrap();
+        assert_eq!(s.elements().len(), 17);
+        assert_eq!(s.switch_len(), 13);
     }
 }

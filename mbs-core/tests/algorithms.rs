@@ -132,6 +132,52 @@ fn pendulum_period_matches_the_exact_large_amplitude_formula() {
     }
 }
 
+/// Parameters of an acrobot (double pendulum) with unequal links, angles from the x axis.
+#[derive(Clone, Copy)]
+struct Acrobot {
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    lc1: f64,
+    lc2: f64,
+    i1: f64,
+    i2: f64,
+    g: f64,
+}
+
+const ACROBOT: Acrobot = Acrobot {
+    m1: 1.1,
+    m2: 0.8,
+    l1: 1.2,
+    lc1: 0.5,
+    lc2: 0.7,
+    i1: 0.09,
+    i2: 0.13,
+    g: 9.81,
+};
+
+impl Acrobot {
+    fn model(&self) -> Model {
+        let mut b = ModelBuilder::new();
+        b.gravity([0.0, -self.g])
+            .add_link(
+                "upper",
+                None,
+                JointKind::Revolute,
+                Placement::default(),
+                BodySpec::new(self.m1, [self.lc1, 0.0], self.i1),
+            )
+            .add_link(
+                "lower",
+                Some("upper"),
+                JointKind::Revolute,
+                Placement::offset(self.l1, 0.0),
+                BodySpec::new(self.m2, [self.lc2, 0.0], self.i2),
+            );
+        b.build().unwrap()
+    }
+}
+
 /// Times of upward zero crossings of coordinate 0 (about `offset`) over a run with RK4,
 /// each refined on the cubic Hermite interpolant of the step.
 fn upward_crossings(
@@ -175,24 +221,17 @@ fn double_pendulum_normal_mode_periods_match_the_linearised_closed_form() {
     // mass matrix at q₂ = 0 and K the Hessian of the potential:
     //   K11 = g (m1 lc1 + m2 (l1 + lc2)),  K12 = K22 = g m2 lc2.
     // det(K − λ M₀) = 0 gives ω² = λ; started along a mode shape, the motion has period 2π/ω.
-    let (m1, m2, l1, lc1, lc2, i1, i2, g) = (1.1, 0.8, 1.2, 0.5, 0.7, 0.09, 0.13, 9.81);
-    let mut b = ModelBuilder::new();
-    b.gravity([0.0, -g])
-        .add_link(
-            "upper",
-            None,
-            JointKind::Revolute,
-            Placement::default(),
-            BodySpec::new(m1, [lc1, 0.0], i1),
-        )
-        .add_link(
-            "lower",
-            Some("upper"),
-            JointKind::Revolute,
-            Placement::offset(l1, 0.0),
-            BodySpec::new(m2, [lc2, 0.0], i2),
-        );
-    let model = b.build().unwrap();
+    let Acrobot {
+        m1,
+        m2,
+        l1,
+        lc1,
+        lc2,
+        i1,
+        i2,
+        g,
+    } = ACROBOT;
+    let model = ACROBOT.model();
     let mut data = Data::new(&model);
     let m11 = i1 + i2 + m1 * lc1 * lc1 + m2 * (l1 * l1 + lc2 * lc2 + 2.0 * l1 * lc2);
     let m12 = i2 + m2 * (lc2 * lc2 + l1 * lc2);
@@ -231,24 +270,17 @@ fn double_pendulum_normal_mode_periods_match_the_linearised_closed_form() {
 #[test]
 fn double_pendulum_matches_the_acrobot_closed_form() {
     // Acrobot (Drake multibody/benchmarks/acrobot) with angles from the x axis and gravity −y.
-    let (m1, m2, l1, lc1, lc2, i1, i2, g) = (1.1, 0.8, 1.2, 0.5, 0.7, 0.09, 0.13, 9.81);
-    let mut b = ModelBuilder::new();
-    b.gravity([0.0, -g])
-        .add_link(
-            "upper",
-            None,
-            JointKind::Revolute,
-            Placement::default(),
-            BodySpec::new(m1, [lc1, 0.0], i1),
-        )
-        .add_link(
-            "lower",
-            Some("upper"),
-            JointKind::Revolute,
-            Placement::offset(l1, 0.0),
-            BodySpec::new(m2, [lc2, 0.0], i2),
-        );
-    let model = b.build().unwrap();
+    let Acrobot {
+        m1,
+        m2,
+        l1,
+        lc1,
+        lc2,
+        i1,
+        i2,
+        g,
+    } = ACROBOT;
+    let model = ACROBOT.model();
     let mut data = Data::new(&model);
     for (q, v) in [
         ([0.3f64, -0.7], [1.2, -0.4]),

@@ -5,14 +5,9 @@
 use std::alloc::{GlobalAlloc, Layout, System as SystemAlloc};
 use std::cell::Cell;
 
-use mbs_core::benchmarks::{branching_tree, planar_chain};
-use mbs_core::elements::{
-    AppliedLoad, Attachment, FrictionLaw, JointSpringDamper, LoadFrame, PivotFriction,
-    PointSpringDamper, SpringLaw,
-};
-use mbs_core::time_function::{PiecewiseLinear, SmoothMove};
+use mbs_core::benchmarks::{branching_tree, branching_tree_system, planar_chain};
 use mbs_core::{
-    Data, Force, Prescribed, System, aba, aba_with_forces, crba, forward_dynamics_crba,
+    Data, Force, Prescribed, aba, aba_with_forces, crba, forward_dynamics_crba,
     forward_kinematics_acc, frame_jacobian, gravity_torque, hybrid_dynamics, kinetic_energy,
     mechanical_energy, nonlinear_effects, point_jacobian, potential_energy, rnea, rnea_with_forces,
 };
@@ -106,62 +101,8 @@ fn algorithms_do_not_allocate() {
 
 #[test]
 fn system_derivative_does_not_allocate() {
-    let model = branching_tree();
-    let mut system = System::new(model.clone());
-    system
-        .add_element(
-            JointSpringDamper::new(
-                &model,
-                "branch1",
-                SpringLaw::new(3.0, 0.1).with_damping(0.2).with_preload(0.5),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-    system
-        .add_element(
-            PointSpringDamper::new(
-                &model,
-                "tether",
-                Attachment::on("twig02", [0.1, 0.0]),
-                Attachment::ground([1.0, 1.0]),
-                SpringLaw::new(50.0, 0.3).with_damping(1.0),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-    system
-        .add_element(
-            PivotFriction::new(
-                &model,
-                "trunk",
-                FrictionLaw::coulomb(0.01, 1e-3)
-                    .with_viscous(0.001)
-                    .with_stribeck(0.02, 0.1),
-            )
-            .unwrap()
-            .with_reversal_events(),
-        )
-        .unwrap();
-    system
-        .add_element(
-            AppliedLoad::force(
-                &model,
-                "push",
-                Attachment::on("twig11", [0.2, 0.0]),
-                [0.0, -1.0],
-                LoadFrame::Body,
-                PiecewiseLinear::new(vec![(0.0, 0.0), (0.1, 5.0), (0.2, 0.0)]).unwrap(),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-    system
-        .add_element(AppliedLoad::torque(&model, "twist", "branch2", |t: f64| t.sin()).unwrap())
-        .unwrap();
-    system
-        .prescribe("twig21", SmoothMove::new(0.0, 0.0, 0.5, 0.3).unwrap())
-        .unwrap();
+    let system = branching_tree_system().unwrap();
+    let model = system.model().clone();
     let mut ws = system.workspace();
     let x = system
         .initial_state(0.0, &vec![0.2; model.nv()], &vec![-0.1; model.nv()])
