@@ -1,0 +1,395 @@
+//! The driver: steps a method from `t0` to `t_end`, reports the solution on a uniform grid,
+//! and locates events on the dense output.
+
+use crate::dopri5::Dopri5;
+use crate::error::{IntegratorError, Result};
+use crate::explicit::{Explicit, Scheme};
+use crate::ode::OdeSystem;
+use crate::options::{Method, Options};
+use crate::solution::{Event, EventAction, Solution, Stats, Termination};
+use crate::stepper::{Control, Stepper};
+use crate::trbdf2::TrBdf2;
+
+/// Integrates `sys` from `(t0, y0)` to `t_end` with `method`, recording every event.
+///
+/// ```
+/// use mbs_integrators::{Method, OdeSystem, Options, SystemError, solve};
+/// /// ẏ = −y
+/// struct Decay;
+/// impl OdeSystem for Decay {
+///     fn len(&self) -> usize { 1 }
+///     fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+///         dy[0] = -y[0];
+///         Ok(())
+///     }
+/// }
+/// let opts = Options::with_tolerances(1e-10, 1e-12);
+/// let sol = solve(&mut Decay, Method::DormandPrince54, 0.0, &[1.0], 1.0, &opts).unwrap();
+/// assert!((sol.y_final[0] - (-1.0f64).exp()).abs() < 1e-9);
+/// ```
+pub fn solve(
+    sys: &mut dyn OdeSystem,
+    method: Method,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    opts: &Options,
+) -> Result<Solution> {
+    solve_with_events(sys, method, t0, y0, t_end, opts, &mut |_, _| {
+        EventAction::Record
+    })
+}
+
+/// Integrates like [`solve`], calling `handler` at each event with the event and a copy of
+/// the state it may modify: returning [`EventAction::Reset`] continues from the modified
+/// state, [`EventAction::Stop`] ends the solve, [`EventAction::Record`] goes on unchanged.
+pub fn solve_with_events(
+    sys: &mut dyn OdeSystem,
+    method: Method,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    opts: &Options,
+    handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
+) -> Result<Solution> {
+    opts.validate(method)?;
+    let n = sys.len();
+    if y0.len() != n {
+        return Err(IntegratorError::InvalidInitialCondition(format!(
+            "y0 has length {}, the system {n}",
+            y0.len()
+        )));
+    }
+    if let Some((i, v)) = y0.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(IntegratorError::InvalidInitialCondition(format!(
+            "y0[{i}] is not finite ({v})"
+        )));
+    }
+    if !(t0.is_finite() && t_end.is_finite() && t_end >= t0) {
+        return Err(IntegratorError::InvalidInitialCondition(format!(
+            "need finite t0 <= t_end, got t0 = {t0}, t_end = {t_end}"
+        )));
+    }
+    let ctl = Control::new(opts);
+    let mut stepper: Box<dyn Stepper> = match method {
+        Method::SemiImplicitEuler => Box::new(Explicit::new(
+            Scheme::SemiImplicitEuler,
+            n,
+            &ctl,
+            sys.second_order_split(),
+        )?),
+        Method::Rk4 => Box::new(Explicit::new(Scheme::Rk4, n, &ctl, None)?),
+        Method::DormandPrince54 => Box::new(Dopri5::new(n, &ctl)),
+        Method::TrBdf2 => Box::new(TrBdf2::new(n, &ctl)),
+    };
+    let mut run = Run::new(sys, opts, n, t0);
+    stepper.start(run.sys, t0, y0, &mut run.stats)?;
+    run.output_point(t0, y0);
+    run.init_events(t0, y0)?;
+    let mut termination = Termination::Finished;
+    while stepper.t() < t_end {
+        if run.stats.steps >= opts.max_steps {
+            return Err(IntegratorError::TooManySteps {
+                t: stepper.t(),
+                max_steps: opts.max_steps,
+            });
+        }
+        stepper.step(run.sys, t_end, &mut run.stats)?;
+        let t_reached = stepper.t();
+        match run.scan_events(stepper.as_ref(), handler)? {
+            None => {
+                run.output_until(stepper.as_ref(), t_reached, true);
+                run.g_prev.copy_from_slice(&run.g_end);
+            }
+            Some((t_event, action, y_event)) => {
+                run.output_until(stepper.as_ref(), t_event, false);
+                if action == EventAction::Stop {
+                    run.output_point_if_stepwise(t_event, &y_event);
+                    run.finish_at(t_event, &y_event);
+                    termination = Termination::Stopped;
+                    break;
+                }
+                stepper.start(run.sys, t_event, &y_event, &mut run.stats)?;
+                run.init_events(t_event, &y_event)?;
+            }
+        }
+    }
+    if termination == Termination::Finished {
+        let (t, y) = (stepper.t(), stepper.y().to_vec());
+        if opts.output_step.is_some() {
+            // The grid may not land on t_end: close the record there.
+            if run.t.last().is_none_or(|&last| last < t) {
+                run.output_point(t, &y);
+            }
+        }
+        run.finish_at(t, &y);
+    }
+    Ok(Solution {
+        t: run.t,
+        y: run.y,
+        n,
+        events: run.events,
+        stats: run.stats,
+        t_final: run.t_final,
+        y_final: run.y_final,
+        termination,
+    })
+}
+
+/// The bookkeeping of one solve.
+struct Run<'s> {
+    sys: &'s mut dyn OdeSystem,
+    n: usize,
+    t0: f64,
+    output_step: Option<f64>,
+    next_grid: usize,
+    event_tol: f64,
+    samples: usize,
+    t: Vec<f64>,
+    y: Vec<f64>,
+    events: Vec<Event>,
+    stats: Stats,
+    m: usize,
+    g_prev: Vec<f64>,
+    g_end: Vec<f64>,
+    g_a: Vec<f64>,
+    g_b: Vec<f64>,
+    g_mid: Vec<f64>,
+    y_tmp: Vec<f64>,
+    t_final: f64,
+    y_final: Vec<f64>,
+}
+
+impl<'s> Run<'s> {
+    fn new(sys: &'s mut dyn OdeSystem, opts: &Options, n: usize, t0: f64) -> Self {
+        let m = sys.event_count();
+        Self {
+            sys,
+            n,
+            t0,
+            output_step: opts.output_step,
+            next_grid: 0,
+            event_tol: opts.event_tolerance,
+            samples: opts.event_samples,
+            t: Vec::new(),
+            y: Vec::new(),
+            events: Vec::new(),
+            stats: Stats::default(),
+            m,
+            g_prev: vec![0.0; m],
+            g_end: vec![0.0; m],
+            g_a: vec![0.0; m],
+            g_b: vec![0.0; m],
+            g_mid: vec![0.0; m],
+            y_tmp: vec![0.0; n],
+            t_final: t0,
+            y_final: Vec::new(),
+        }
+    }
+
+    fn output_point(&mut self, t: f64, y: &[f64]) {
+        self.t.push(t);
+        self.y.extend_from_slice(y);
+        if self.output_step.is_some() {
+            self.next_grid += 1;
+        }
+    }
+
+    /// After a stop with output at every step, the stopping point is a step end.
+    fn output_point_if_stepwise(&mut self, t: f64, y: &[f64]) {
+        if self.output_step.is_none() && self.t.last() != Some(&t) {
+            self.output_point(t, y);
+        }
+    }
+
+    fn finish_at(&mut self, t: f64, y: &[f64]) {
+        self.t_final = t;
+        self.y_final = y.to_vec();
+    }
+
+    /// Output up to `t_until` from the stepper's last step: grid points at or before it
+    /// (interpolated), or, without a grid, the step end when `step_end` is set.
+    fn output_until(&mut self, st: &dyn Stepper, t_until: f64, step_end: bool) {
+        match self.output_step {
+            None => {
+                if step_end {
+                    self.t.push(st.t());
+                    self.y.extend_from_slice(st.y());
+                }
+            }
+            Some(dt) => loop {
+                let tg = self.t0 + self.next_grid as f64 * dt;
+                if tg > t_until + 1e-12 * dt {
+                    break;
+                }
+                let tg = tg.min(t_until);
+                let mut y = vec![0.0; self.n];
+                st.interpolate(tg.max(st.t_prev()), &mut y);
+                self.t.push(tg);
+                self.y.extend_from_slice(&y);
+                self.next_grid += 1;
+            },
+        }
+    }
+
+    fn eval_events(&mut self, t: f64, y: &[f64], out_b: bool) -> Result<()> {
+        if self.m == 0 {
+            return Ok(());
+        }
+        self.stats.event_evals += 1;
+        let out = if out_b {
+            &mut self.g_b
+        } else {
+            &mut self.g_mid
+        };
+        self.sys
+            .events(t, y, out)
+            .map_err(|source| IntegratorError::System { t, source })?;
+        if let Some(k) = out.iter().position(|g| !g.is_finite()) {
+            return Err(IntegratorError::System {
+                t,
+                source: crate::SystemError::new(format!(
+                    "switching function '{}' is not finite",
+                    self.sys.event_name(k)
+                )),
+            });
+        }
+        Ok(())
+    }
+
+    fn init_events(&mut self, t: f64, y: &[f64]) -> Result<()> {
+        if self.m == 0 {
+            return Ok(());
+        }
+        self.eval_events(t, y, true)?;
+        self.g_prev.copy_from_slice(&self.g_b);
+        Ok(())
+    }
+
+    /// Looks for crossings during the last step, at `samples` points of the dense output.
+    /// Events are handled in time order; returns the first that stops or resets the
+    /// solve, with the state to go on from.
+    fn scan_events(
+        &mut self,
+        st: &dyn Stepper,
+        handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
+    ) -> Result<Option<(f64, EventAction, Vec<f64>)>> {
+        if self.m == 0 {
+            return Ok(None);
+        }
+        let (t0, t1) = (st.t_prev(), st.t());
+        // Found crossings: (time, function).
+        let mut found: Vec<(f64, usize)> = Vec::new();
+        self.g_a.copy_from_slice(&self.g_prev);
+        let mut ta = t0;
+        for s in 1..=self.samples {
+            let tb = if s == self.samples {
+                t1
+            } else {
+                t0 + (t1 - t0) * s as f64 / self.samples as f64
+            };
+            if s == self.samples {
+                let y = st.y().to_vec();
+                self.eval_events(tb, &y, true)?;
+            } else {
+                let mut y = std::mem::take(&mut self.y_tmp);
+                st.interpolate(tb, &mut y);
+                let r = self.eval_events(tb, &y, true);
+                self.y_tmp = y;
+                r?;
+            }
+            for k in 0..self.m {
+                let dir = self.sys.event_direction(k);
+                if dir.crosses(self.g_a[k], self.g_b[k]) {
+                    let tk = self.locate(st, k, ta, tb, self.g_a[k], self.g_b[k])?;
+                    found.push((tk, k));
+                }
+            }
+            ta = tb;
+            self.g_a.copy_from_slice(&self.g_b);
+        }
+        self.g_end.copy_from_slice(&self.g_b);
+        found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for (te, k) in found {
+            let mut y = vec![0.0; self.n];
+            st.interpolate(te, &mut y);
+            let mut event = Event {
+                index: k,
+                name: self.sys.event_name(k),
+                time: te,
+                state: y.clone(),
+                action: EventAction::Record,
+            };
+            let action = handler(&event, &mut y);
+            event.action = action;
+            self.events.push(event);
+            match action {
+                EventAction::Record => {}
+                EventAction::Stop => {
+                    let y0 = self.events.last().map(|e| e.state.clone()).unwrap_or(y);
+                    return Ok(Some((te, action, y0)));
+                }
+                EventAction::Reset => {
+                    if let Some((i, v)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                        return Err(IntegratorError::NonFiniteState {
+                            t: te,
+                            index: i,
+                            value: *v,
+                        });
+                    }
+                    return Ok(Some((te, action, y)));
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// The crossing of function `k` between `ta` (value `ga`) and `tb` (value `gb`), by the
+    /// Illinois variant of regula falsi on the dense output, to the event tolerance. The
+    /// time returned is on the far side of the crossing.
+    fn locate(
+        &mut self,
+        st: &dyn Stepper,
+        k: usize,
+        ta: f64,
+        tb: f64,
+        ga: f64,
+        gb: f64,
+    ) -> Result<f64> {
+        let (mut a, mut b, mut fa, mut fb) = (ta, tb, ga, gb);
+        let mut side = 0i32;
+        let mut y = vec![0.0; self.n];
+        let tol = self.event_tol.max(4.0 * f64::EPSILON * tb.abs());
+        for _ in 0..200 {
+            if b - a <= tol {
+                break;
+            }
+            let mut c = b - fb * (b - a) / (fb - fa);
+            if !(c > a && c < b) {
+                c = 0.5 * (a + b);
+            }
+            // Keep the bracket shrinking geometrically even when regula falsi crawls.
+            let w = b - a;
+            c = c.clamp(a + 0.01 * w, b - 0.01 * w);
+            st.interpolate(c, &mut y);
+            self.eval_events(c, &y, false)?;
+            let fc = self.g_mid[k];
+            if (fc < 0.0) == (fa < 0.0) && fc != 0.0 {
+                a = c;
+                fa = fc;
+                if side == -1 {
+                    fb *= 0.5;
+                }
+                side = -1;
+            } else {
+                b = c;
+                fb = fc;
+                if side == 1 {
+                    fa *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        Ok(b)
+    }
+}

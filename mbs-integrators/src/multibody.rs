@@ -1,0 +1,86 @@
+//! Running an `mbs_core::System` through the integrators.
+
+use mbs_core::{Crossing, System, Workspace};
+
+use crate::error::SystemError;
+use crate::ode::{Direction, OdeSystem};
+
+/// An `mbs_core::System` seen as an [`OdeSystem`]: the state is the system's
+/// `[q, v, internal states]`, the switching functions are the force elements', named
+/// `"<element> #<k>"`. It is second order (`q̇ = v`), so every method applies.
+pub struct MultibodyOde<'a> {
+    system: &'a System,
+    ws: Workspace,
+    names: Vec<String>,
+}
+
+impl<'a> MultibodyOde<'a> {
+    /// Wraps a system (with its own workspace).
+    pub fn new(system: &'a System) -> Self {
+        let names = (0..system.switch_len())
+            .map(|k| match system.switch_info(k) {
+                Some((e, local, _)) => {
+                    let name = system.elements().nth(e).map_or("element", |el| el.name());
+                    format!("{name} #{local}")
+                }
+                None => format!("switch {k}"),
+            })
+            .collect();
+        Self {
+            system,
+            ws: system.workspace(),
+            names,
+        }
+    }
+
+    /// The workspace of the last evaluation (poses, forces, drive forces).
+    pub fn workspace(&self) -> &Workspace {
+        &self.ws
+    }
+
+    /// The wrapped system.
+    pub fn system(&self) -> &System {
+        self.system
+    }
+}
+
+impl OdeSystem for MultibodyOde<'_> {
+    fn len(&self) -> usize {
+        self.system.state_len()
+    }
+
+    fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+        self.system
+            .derivative(&mut self.ws, t, y, dy)
+            .map_err(SystemError::new)
+    }
+
+    fn second_order_split(&self) -> Option<usize> {
+        Some(self.system.model().nv())
+    }
+
+    fn event_count(&self) -> usize {
+        self.system.switch_len()
+    }
+
+    fn events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
+        self.system
+            .switching_functions(&mut self.ws, t, y, out)
+            .map_err(SystemError::new)
+    }
+
+    fn event_direction(&self, k: usize) -> Direction {
+        match self.system.switch_info(k).map(|(_, _, c)| c) {
+            Some(Crossing::Rising) => Direction::Rising,
+            Some(Crossing::Falling) => Direction::Falling,
+            _ => Direction::Both,
+        }
+    }
+
+    fn event_name(&self, k: usize) -> String {
+        self.names
+            .get(k)
+            .cloned()
+            .unwrap_or_else(|| format!("switch {k}"))
+    }
+}

@@ -1,0 +1,88 @@
+//! The [`OdeSystem`] trait: what the integrators need of a system `ẏ = f(t, y)`.
+
+use nalgebra::DMatrix;
+
+use crate::error::SystemError;
+
+/// Which zero crossings of a switching function are events.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// From negative to positive.
+    Rising,
+    /// From positive to negative.
+    Falling,
+    /// Either way.
+    Both,
+}
+
+impl Direction {
+    /// Whether going from `g0` to `g1` is a crossing in this direction.
+    pub fn crosses(self, g0: f64, g1: f64) -> bool {
+        let rising = g0 < 0.0 && g1 >= 0.0;
+        let falling = g0 > 0.0 && g1 <= 0.0;
+        match self {
+            Direction::Rising => rising,
+            Direction::Falling => falling,
+            Direction::Both => rising || falling,
+        }
+    }
+}
+
+/// A first-order system `ẏ = f(t, y)` with optional Jacobian and switching functions.
+///
+/// Methods take `&mut self` so a system can keep its own workspace.
+pub trait OdeSystem {
+    /// Length of the state.
+    fn len(&self) -> usize;
+
+    /// Whether the state is empty.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Writes `f(t, y)` into `dy`.
+    fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError>;
+
+    /// Whether [`OdeSystem::jacobian`] is implemented; otherwise the implicit method uses
+    /// finite differences.
+    fn has_jacobian(&self) -> bool {
+        false
+    }
+
+    /// Writes `∂f/∂y` at `(t, y)` into `jac` (len × len).
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        _jac: &mut DMatrix<f64>,
+    ) -> Result<(), SystemError> {
+        Err(SystemError::new("this system has no analytic Jacobian"))
+    }
+
+    /// For a mechanical system whose state is `y = [q (n), v (n), others]` with `q̇ = v`:
+    /// `Some(n)`. Needed by the semi-implicit (symplectic) Euler method.
+    fn second_order_split(&self) -> Option<usize> {
+        None
+    }
+
+    /// Number of switching functions.
+    fn event_count(&self) -> usize {
+        0
+    }
+
+    /// Writes the switching functions at `(t, y)` into `out` (length
+    /// [`OdeSystem::event_count`]); an event happens where one crosses zero.
+    fn events(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) -> Result<(), SystemError> {
+        Ok(())
+    }
+
+    /// Which crossings of switching function `k` are events.
+    fn event_direction(&self, _k: usize) -> Direction {
+        Direction::Both
+    }
+
+    /// A name for switching function `k`, used in the event list.
+    fn event_name(&self, k: usize) -> String {
+        format!("event {k}")
+    }
+}

@@ -1,0 +1,167 @@
+//! What every method provides to the driver: one accepted step at a time, and dense output
+//! over the last step.
+
+use crate::error::{IntegratorError, Result};
+use crate::ode::OdeSystem;
+use crate::options::Options;
+use crate::solution::Stats;
+
+/// One method's stepping state.
+pub(crate) trait Stepper {
+    /// Starts (or restarts, after an event) at `(t, y)`.
+    fn start(&mut self, sys: &mut dyn OdeSystem, t: f64, y: &[f64], st: &mut Stats) -> Result<()>;
+    /// Takes one accepted step, not beyond `t_max`.
+    fn step(&mut self, sys: &mut dyn OdeSystem, t_max: f64, st: &mut Stats) -> Result<()>;
+    /// Start of the last step.
+    fn t_prev(&self) -> f64;
+    /// Current time (end of the last step).
+    fn t(&self) -> f64;
+    /// Current state.
+    fn y(&self) -> &[f64];
+    /// The dense-output state at `t` in `[t_prev, t]`.
+    fn interpolate(&self, t: f64, out: &mut [f64]);
+}
+
+/// Evaluates the derivative, counting it and naming the time of a failure. Returns
+/// `Ok(false)` when the result is not finite (the caller may retry with a smaller step).
+pub(crate) fn eval(
+    sys: &mut dyn OdeSystem,
+    t: f64,
+    y: &[f64],
+    dy: &mut [f64],
+    st: &mut Stats,
+) -> Result<bool> {
+    st.derivative_evals += 1;
+    sys.derivative(t, y, dy)
+        .map_err(|source| IntegratorError::System { t, source })?;
+    Ok(dy.iter().all(|v| v.is_finite()))
+}
+
+/// The first non-finite component of `y`, as an error at time `t`.
+pub(crate) fn non_finite(t: f64, y: &[f64]) -> IntegratorError {
+    let (index, value) = y
+        .iter()
+        .copied()
+        .enumerate()
+        .find(|(_, v)| !v.is_finite())
+        .unwrap_or((0, f64::NAN));
+    IntegratorError::NonFiniteState { t, index, value }
+}
+
+/// Tolerances and step limits, taken from the options.
+#[derive(Clone, Debug)]
+pub(crate) struct Control {
+    pub rtol: f64,
+    pub atol: f64,
+    pub h_init: Option<f64>,
+    pub h_max: f64,
+    pub fixed: Option<f64>,
+    opts: Options,
+}
+
+impl Control {
+    pub fn new(opts: &Options) -> Self {
+        Self {
+            rtol: opts.rtol,
+            atol: opts.atol,
+            h_init: opts.initial_step,
+            h_max: opts.max_step,
+            fixed: opts.fixed_step,
+            opts: opts.clone(),
+        }
+    }
+
+    pub fn h_min(&self, t: f64) -> f64 {
+        self.opts.h_min(t)
+    }
+
+    /// Weighted RMS norm of an error vector (Hairer):
+    /// `sqrt(mean((e_i / (atol + rtol max(|y0_i|, |y1_i|)))²))`.
+    pub fn error_norm(&self, err: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        let n = err.len().max(1) as f64;
+        let s: f64 = err
+            .iter()
+            .zip(y0.iter().zip(y1))
+            .map(|(e, (a, b))| {
+                let sc = self.atol + self.rtol * a.abs().max(b.abs());
+                (e / sc) * (e / sc)
+            })
+            .sum();
+        (s / n).sqrt()
+    }
+
+    /// Hairer's automatic first step for a method of order `order`.
+    pub fn initial_step(
+        &self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        f0: &[f64],
+        order: usize,
+        st: &mut Stats,
+    ) -> Result<f64> {
+        if let Some(h) = self.h_init {
+            return Ok(h.min(self.h_max));
+        }
+        let zeros = vec![0.0; y.len()];
+        let d0 = self.error_norm(y, &zeros, y);
+        let d1 = self.error_norm(f0, &zeros, y);
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        }
+        .min(self.h_max);
+        let y1: Vec<f64> = y.iter().zip(f0).map(|(a, b)| a + h0 * b).collect();
+        let mut f1 = vec![0.0; y.len()];
+        if !eval(sys, t + h0, &y1, &mut f1, st)? {
+            return Ok(h0 * 1e-3);
+        }
+        let df: Vec<f64> = f1.iter().zip(f0).map(|(a, b)| (a - b) / h0).collect();
+        let d2 = self.error_norm(&df, &zeros, y);
+        let h1 = if d1.max(d2) <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
+        };
+        Ok((100.0 * h0).min(h1).min(self.h_max).max(self.h_min(t)))
+    }
+}
+
+/// Cubic Hermite interpolation on `[t0, t0 + h]` through `(y0, f0)` and `(y1, f1)`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn hermite(
+    t0: f64,
+    h: f64,
+    y0: &[f64],
+    f0: &[f64],
+    y1: &[f64],
+    f1: &[f64],
+    t: f64,
+    out: &mut [f64],
+) {
+    if h == 0.0 {
+        out.copy_from_slice(y1);
+        return;
+    }
+    let s = (t - t0) / h;
+    let (s2, s3) = (s * s, s * s * s);
+    let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+    let h10 = s3 - 2.0 * s2 + s;
+    let h01 = -2.0 * s3 + 3.0 * s2;
+    let h11 = s3 - s2;
+    for i in 0..out.len() {
+        out[i] = h00 * y0[i] + h * h10 * f0[i] + h01 * y1[i] + h * h11 * f1[i];
+    }
+}
+
+/// The step actually taken towards `t_max`: `h`, or what is left when that is within a
+/// hair of `h` (so no sliver step remains).
+pub(crate) fn clip_step(t: f64, h: f64, t_max: f64) -> (f64, bool) {
+    let left = t_max - t;
+    if h >= left * (1.0 - 1e-12) {
+        (left, true)
+    } else {
+        (h, false)
+    }
+}

@@ -1,0 +1,373 @@
+//! TR-BDF2 (Bank, Coughran, Fichtner, Grosse, Rose & Smith, 1985), as analysed and
+//! implemented by Hosea & Shampine, "Analysis and implementation of TR-BDF2", *Applied
+//! Numerical Mathematics* 20 (1996), the method of MATLAB's `ode23tb`.
+//!
+//! With `γ = 2 − √2`, `d = γ/2`, `w = √2/4`, a step is a trapezoidal stage to `t + γh`
+//! followed by a BDF2 stage to `t + h`, written as an ESDIRK:
+//!
+//! ```text
+//! z_γ     = y_n + h d (f_n + f(z_γ))
+//! y_{n+1} = y_n + h (w f_n + w f_γ + d f(y_{n+1}))
+//! ```
+//!
+//! Both stages share the iteration matrix `W = I − h d J`: one LU per step size, solved by
+//! modified Newton with the Jacobian `J` kept across steps and refreshed only when Newton
+//! struggles. The method is L-stable and second order. The local error is estimated with
+//! the embedded third-order weights `((1 − w)/3, (3w + 1)/3, d/3)` and filtered through
+//! `W⁻¹` (Hosea & Shampine) so it does not overestimate on stiff components.
+
+use crate::error::{IntegratorError, Result};
+use crate::linalg::Lu;
+use crate::ode::OdeSystem;
+use crate::solution::Stats;
+use crate::stepper::{Control, Stepper, clip_step, eval, hermite, non_finite};
+
+const SQRT2: f64 = std::f64::consts::SQRT_2;
+const GAMMA: f64 = 2.0 - SQRT2;
+const D: f64 = GAMMA / 2.0;
+const W: f64 = SQRT2 / 4.0;
+/// Error weights: embedded 3rd-order weights minus the method's `(w, w, d)`.
+const E0: f64 = (1.0 - 4.0 * W) / 3.0;
+const E1: f64 = W + 1.0 / 3.0;
+const E2: f64 = -2.0 * D / 3.0;
+/// Newton: maximum iterations per stage, and the convergence threshold on the weighted
+/// norm of the remaining correction.
+const NEWTON_MAX: usize = 8;
+const NEWTON_TOL: f64 = 0.03;
+
+pub(crate) struct TrBdf2 {
+    ctl: Control,
+    n: usize,
+    t: f64,
+    t_prev: f64,
+    h: f64,
+    y: Vec<f64>,
+    f: Vec<f64>,
+    y_prev: Vec<f64>,
+    f_prev: Vec<f64>,
+    z_gamma: Vec<f64>,
+    f_gamma: Vec<f64>,
+    z_end: Vec<f64>,
+    f_end: Vec<f64>,
+    psi: Vec<f64>,
+    fz: Vec<f64>,
+    delta: Vec<f64>,
+    est: Vec<f64>,
+    jac: nalgebra::DMatrix<f64>,
+    jac_tmp: Vec<f64>,
+    jac_valid: bool,
+    /// Whether `jac` was evaluated at the start of the current step.
+    jac_fresh: bool,
+    lu: Lu,
+    /// The `h d` of the current factorisation (NaN when none).
+    lu_c: f64,
+}
+
+enum Stage {
+    Converged,
+    Failed,
+}
+
+impl TrBdf2 {
+    pub fn new(n: usize, ctl: &Control) -> Self {
+        let v = || vec![0.0; n];
+        Self {
+            ctl: ctl.clone(),
+            n,
+            t: 0.0,
+            t_prev: 0.0,
+            h: 0.0,
+            y: v(),
+            f: v(),
+            y_prev: v(),
+            f_prev: v(),
+            z_gamma: v(),
+            f_gamma: v(),
+            z_end: v(),
+            f_end: v(),
+            psi: v(),
+            fz: v(),
+            delta: v(),
+            est: v(),
+            jac: nalgebra::DMatrix::zeros(n, n),
+            jac_tmp: v(),
+            jac_valid: false,
+            jac_fresh: false,
+            lu: Lu::new(n),
+            lu_c: f64::NAN,
+        }
+    }
+
+    /// J at (t, y): analytic if the system has one, else forward differences.
+    fn update_jacobian(&mut self, sys: &mut dyn OdeSystem, st: &mut Stats) -> Result<()> {
+        st.jacobian_evals += 1;
+        let t = self.t;
+        if sys.has_jacobian() {
+            sys.jacobian(t, &self.y, &mut self.jac)
+                .map_err(|source| IntegratorError::System { t, source })?;
+        } else {
+            let mut yp = self.y.clone();
+            for j in 0..self.n {
+                let yj = self.y[j];
+                let dj = f64::EPSILON.sqrt() * yj.abs().max(1e-5);
+                yp[j] = yj + dj;
+                let dj = yp[j] - yj;
+                if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
+                    return Err(non_finite(t, &self.jac_tmp));
+                }
+                for i in 0..self.n {
+                    self.jac[(i, j)] = (self.jac_tmp[i] - self.f[i]) / dj;
+                }
+                yp[j] = yj;
+            }
+        }
+        if self.jac.iter().any(|v| !v.is_finite()) {
+            return Err(IntegratorError::System {
+                t,
+                source: crate::SystemError::new("the Jacobian has non-finite entries"),
+            });
+        }
+        self.jac_valid = true;
+        self.jac_fresh = true;
+        self.lu_c = f64::NAN;
+        Ok(())
+    }
+
+    /// Factors W = I − c J unless already done for this c.
+    fn factor(&mut self, c: f64, st: &mut Stats) -> Result<()> {
+        if self.lu_c == c {
+            return Ok(());
+        }
+        st.lu_decompositions += 1;
+        if !self.lu.factor_shifted(c, self.jac.as_slice()) {
+            self.lu_c = f64::NAN;
+            return Err(IntegratorError::SingularMatrix {
+                t: self.t,
+                h: c / D,
+            });
+        }
+        self.lu_c = c;
+        Ok(())
+    }
+
+    /// Solves `z = ψ + c f(ts, z)` by modified Newton from the guess in `z`; on success
+    /// `fz` holds f(ts, z).
+    fn newton(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        ts: f64,
+        c: f64,
+        which_end: bool,
+        st: &mut Stats,
+    ) -> Result<Stage> {
+        let mut prev = f64::INFINITY;
+        let mut rate: f64 = 1.0;
+        for k in 0..NEWTON_MAX {
+            st.newton_iterations += 1;
+            let z = if which_end {
+                &self.z_end
+            } else {
+                &self.z_gamma
+            };
+            if !eval(sys, ts, z, &mut self.fz, st)? {
+                return Ok(Stage::Failed);
+            }
+            // δ = −W⁻¹ (z − ψ − c f(z))
+            for i in 0..self.n {
+                self.delta[i] = -(z[i] - self.psi[i] - c * self.fz[i]);
+            }
+            self.lu.solve(&mut self.delta);
+            let z = if which_end {
+                &mut self.z_end
+            } else {
+                &mut self.z_gamma
+            };
+            for i in 0..self.n {
+                z[i] += self.delta[i];
+            }
+            let norm = self.ctl.error_norm(&self.delta, &self.y, z);
+            if !norm.is_finite() {
+                return Ok(Stage::Failed);
+            }
+            if k > 0 {
+                rate = norm / prev;
+                if rate >= 0.9 {
+                    return Ok(Stage::Failed);
+                }
+            }
+            // Remaining error ≈ rate/(1 − rate) · ‖δ‖ once the rate is known.
+            let remaining = if k > 0 {
+                rate / (1.0 - rate) * norm
+            } else {
+                norm
+            };
+            if remaining <= NEWTON_TOL || norm <= 1e-12 {
+                let z = if which_end {
+                    &self.z_end
+                } else {
+                    &self.z_gamma
+                };
+                if !eval(sys, ts, z, &mut self.fz, st)? {
+                    return Ok(Stage::Failed);
+                }
+                return Ok(Stage::Converged);
+            }
+            prev = norm;
+        }
+        Ok(Stage::Failed)
+    }
+
+    /// Both stages with step h. Ok(false) when Newton failed.
+    fn attempt(&mut self, sys: &mut dyn OdeSystem, h: f64, st: &mut Stats) -> Result<bool> {
+        let c = h * D;
+        self.factor(c, st)?;
+        let n = self.n;
+        // Trapezoidal stage: z_γ = y + h d (f_n + f(z_γ)), guess y + γ h f_n.
+        for i in 0..n {
+            self.psi[i] = self.y[i] + c * self.f[i];
+            self.z_gamma[i] = self.y[i] + GAMMA * h * self.f[i];
+        }
+        if let Stage::Failed = self.newton(sys, self.t + GAMMA * h, c, false, st)? {
+            return Ok(false);
+        }
+        self.f_gamma.copy_from_slice(&self.fz);
+        // BDF2 stage: y_{n+1} = y + h w (f_n + f_γ) + h d f(y_{n+1}), guess by linear
+        // extrapolation through y and z_γ.
+        for i in 0..n {
+            self.psi[i] = self.y[i] + h * W * (self.f[i] + self.f_gamma[i]);
+            self.z_end[i] = self.y[i] + (self.z_gamma[i] - self.y[i]) / GAMMA;
+        }
+        if let Stage::Failed = self.newton(sys, self.t + h, c, true, st)? {
+            return Ok(false);
+        }
+        self.f_end.copy_from_slice(&self.fz);
+        Ok(true)
+    }
+}
+
+impl Stepper for TrBdf2 {
+    fn start(&mut self, sys: &mut dyn OdeSystem, t: f64, y: &[f64], st: &mut Stats) -> Result<()> {
+        self.t = t;
+        self.t_prev = t;
+        self.y.copy_from_slice(y);
+        self.y_prev.copy_from_slice(y);
+        if !eval(sys, t, y, &mut self.f, st)? {
+            return Err(non_finite(t, &self.f));
+        }
+        self.f_prev.copy_from_slice(&self.f);
+        if self.h == 0.0 {
+            self.h = match self.ctl.fixed {
+                Some(h) => h,
+                None => self.ctl.initial_step(sys, t, y, &self.f, 2, st)?,
+            };
+        }
+        // After a restart (event) the old Jacobian may be far off: refresh lazily.
+        self.jac_valid = false;
+        Ok(())
+    }
+
+    fn step(&mut self, sys: &mut dyn OdeSystem, t_max: f64, st: &mut Stats) -> Result<()> {
+        if !self.jac_valid {
+            self.update_jacobian(sys, st)?;
+        }
+        let mut rejected_once = false;
+        loop {
+            let h_min = self.ctl.h_min(self.t);
+            let (h, _) = clip_step(self.t, self.h.min(self.ctl.h_max), t_max);
+            if !self.attempt(sys, h, st)? {
+                st.newton_failures += 1;
+                if !self.jac_fresh {
+                    // First remedy: a Jacobian at the current point, same step.
+                    self.update_jacobian(sys, st)?;
+                    continue;
+                }
+                if self.ctl.fixed.is_some() || 0.25 * h < h_min {
+                    return Err(IntegratorError::NewtonFailure { t: self.t, h });
+                }
+                st.rejected += 1;
+                rejected_once = true;
+                self.h = 0.25 * h;
+                continue;
+            }
+            if self.ctl.fixed.is_some() {
+                self.accept(h, st);
+                return Ok(());
+            }
+            // est = h (E0 f_n + E1 f_γ + E2 f_{n+1}), filtered: err = W⁻¹ est.
+            for i in 0..self.n {
+                self.est[i] = h * (E0 * self.f[i] + E1 * self.f_gamma[i] + E2 * self.f_end[i]);
+            }
+            self.lu.solve(&mut self.est);
+            let err = self.ctl.error_norm(&self.est, &self.y, &self.z_end);
+            // Third-order local error: h_new = h · 0.9 err^(−1/3), within [0.2, 5].
+            let mut fac = if err > 0.0 {
+                0.9 * err.powf(-1.0 / 3.0)
+            } else {
+                5.0
+            };
+            fac = fac.clamp(0.2, 5.0);
+            if err <= 1.0 {
+                if rejected_once {
+                    fac = fac.min(1.0);
+                }
+                self.accept(h, st);
+                // Keep h (and the LU) when the change would be small.
+                if !(1.0..=1.2).contains(&fac) {
+                    self.h = (h * fac).min(self.ctl.h_max);
+                } else {
+                    self.h = h;
+                }
+                return Ok(());
+            }
+            st.rejected += 1;
+            rejected_once = true;
+            self.h = h * fac.min(0.9);
+            if self.h < h_min {
+                return Err(IntegratorError::StepSizeTooSmall {
+                    t: self.t,
+                    h: self.h,
+                    h_min,
+                    reason: "local error above tolerance",
+                });
+            }
+        }
+    }
+
+    fn t_prev(&self) -> f64 {
+        self.t_prev
+    }
+
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        hermite(
+            self.t_prev,
+            self.t - self.t_prev,
+            &self.y_prev,
+            &self.f_prev,
+            &self.y,
+            &self.f,
+            t,
+            out,
+        );
+    }
+}
+
+impl TrBdf2 {
+    fn accept(&mut self, h: f64, st: &mut Stats) {
+        std::mem::swap(&mut self.y_prev, &mut self.y);
+        std::mem::swap(&mut self.f_prev, &mut self.f);
+        self.y.copy_from_slice(&self.z_end);
+        self.f.copy_from_slice(&self.f_end);
+        self.t_prev = self.t;
+        self.t += h;
+        self.jac_fresh = false;
+        st.steps += 1;
+    }
+}
