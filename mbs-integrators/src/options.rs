@@ -141,7 +141,7 @@ impl Options {
         {
             return bad("min_step", format!("must be non-negative, got {h}"));
         }
-        if !(self.max_step > 0.0) {
+        if self.max_step.is_nan() || self.max_step <= 0.0 {
             return bad(
                 "max_step",
                 format!("must be positive, got {}", self.max_step),
