@@ -357,24 +357,32 @@ impl<'s> Run<'s> {
         gb: f64,
     ) -> Result<f64> {
         let (mut a, mut b, mut fa, mut fb) = (ta, tb, ga, gb);
+        // Sides: negative, or non-negative (zero included), as in `Direction::crosses`.
+        let a_negative = ga < 0.0;
         let mut side = 0i32;
         let mut y = vec![0.0; self.n];
         let tol = self.event_tol.max(4.0 * f64::EPSILON * tb.abs());
-        for _ in 0..200 {
-            if b - a <= tol {
+        let mut widths = [f64::INFINITY; 2];
+        for _ in 0..500 {
+            let w = b - a;
+            if w <= tol {
                 break;
             }
-            let mut c = b - fb * (b - a) / (fb - fa);
+            // Regula falsi (Illinois), but bisect when the bracket has not halved in two
+            // iterations, so the worst case is bisection's.
+            let mut c = if w > 0.5 * widths[0] {
+                0.5 * (a + b)
+            } else {
+                b - fb * (b - a) / (fb - fa)
+            };
             if !(c > a && c < b) {
                 c = 0.5 * (a + b);
             }
-            // Keep the bracket shrinking geometrically even when regula falsi crawls.
-            let w = b - a;
-            c = c.clamp(a + 0.01 * w, b - 0.01 * w);
+            widths = [widths[1], w];
             st.interpolate(c, &mut y);
             self.eval_events(c, &y, false)?;
             let fc = self.g_mid[k];
-            if (fc < 0.0) == (fa < 0.0) && fc != 0.0 {
+            if (fc < 0.0) == a_negative {
                 a = c;
                 fa = fc;
                 if side == -1 {

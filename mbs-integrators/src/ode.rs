@@ -16,10 +16,12 @@ pub enum Direction {
 }
 
 impl Direction {
-    /// Whether going from `g0` to `g1` is a crossing in this direction.
+    /// Whether going from `g0` to `g1` is a crossing in this direction. Zero counts as the
+    /// non-negative side, so a crossing is never counted twice and a function reset to
+    /// exactly zero still sees its next crossing.
     pub fn crosses(self, g0: f64, g1: f64) -> bool {
         let rising = g0 < 0.0 && g1 >= 0.0;
-        let falling = g0 > 0.0 && g1 <= 0.0;
+        let falling = g0 >= 0.0 && g1 < 0.0;
         match self {
             Direction::Rising => rising,
             Direction::Falling => falling,

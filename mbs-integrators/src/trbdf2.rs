@@ -26,9 +26,10 @@ const SQRT2: f64 = std::f64::consts::SQRT_2;
 const GAMMA: f64 = 2.0 - SQRT2;
 const D: f64 = GAMMA / 2.0;
 const W: f64 = SQRT2 / 4.0;
-/// Error weights: embedded 3rd-order weights minus the method's `(w, w, d)`.
+/// Error weights: embedded 3rd-order weights minus the method's `(w, w, d)`; they sum to
+/// zero because `2w + d = 1`.
 const E0: f64 = (1.0 - 4.0 * W) / 3.0;
-const E1: f64 = W + 1.0 / 3.0;
+const E1: f64 = 1.0 / 3.0;
 const E2: f64 = -2.0 * D / 3.0;
 /// Newton: maximum iterations per stage, and the convergence threshold on the weighted
 /// norm of the remaining correction.
