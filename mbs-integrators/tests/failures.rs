@@ -1,0 +1,288 @@
+//! Honest failure: every way a solve can go wrong is an error that says when and why,
+//! never a silent wrong answer or a hang.
+
+use mbs_integrators::{IntegratorError, Method, OdeSystem, Options, SystemError, solve};
+
+/// ẏ = y², y(0) = 1: y = 1/(1 − t) blows up at t = 1.
+struct BlowUp;
+
+impl OdeSystem for BlowUp {
+    fn len(&self) -> usize {
+        1
+    }
+    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+        dy[0] = y[0] * y[0];
+        Ok(())
+    }
+}
+
+#[test]
+fn a_finite_time_blow_up_stops_with_the_time_it_happened() {
+    for method in [Method::DormandPrince54, Method::TrBdf2] {
+        let e = solve(&mut BlowUp, method, 0.0, &[1.0], 2.0, &Options::default()).unwrap_err();
+        let t = match e {
+            IntegratorError::StepSizeTooSmall { t, .. } => t,
+            IntegratorError::NonFiniteState { t, .. } => t,
+            IntegratorError::NewtonFailure { t, .. } => t,
+            ref other => panic!("{method:?}: unexpected {other:?}"),
+        };
+        assert!(
+            (0.99..=1.001).contains(&t),
+            "{method:?} failed at t = {t}: {e}"
+        );
+        assert!(e.to_string().contains("at t = "), "{e}");
+    }
+    // A fixed-step method walks into the overflow and says so.
+    let e = solve(
+        &mut BlowUp,
+        Method::Rk4,
+        0.0,
+        &[1.0],
+        2.0,
+        &Options::default().fixed(0.01),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, IntegratorError::NonFiniteState { t, .. } if t > 0.9 && t <= 2.0),
+        "{e:?}"
+    );
+}
+
+/// A system that fails, or returns NaN, after a given time.
+struct Breaks {
+    at: f64,
+    nan: bool,
+}
+
+impl OdeSystem for Breaks {
+    fn len(&self) -> usize {
+        2
+    }
+    fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+        if t > self.at && !self.nan {
+            return Err(SystemError::new("felt law out of range"));
+        }
+        dy[0] = y[1];
+        dy[1] = if t > self.at { f64::NAN } else { -y[0] };
+        Ok(())
+    }
+}
+
+#[test]
+fn system_errors_and_nan_are_reported_with_their_time() {
+    for method in [Method::Rk4, Method::DormandPrince54, Method::TrBdf2] {
+        let opts = if method == Method::Rk4 {
+            Options::default().fixed(0.01)
+        } else {
+            Options::default()
+        };
+        let e = solve(
+            &mut Breaks {
+                at: 0.5,
+                nan: false,
+            },
+            method,
+            0.0,
+            &[1.0, 0.0],
+            1.0,
+            &opts,
+        )
+        .unwrap_err();
+        match &e {
+            IntegratorError::System { t, source } => {
+                assert!(*t > 0.5 && *t < 0.6, "{method:?}: {e}");
+                assert!(source.0.contains("felt law"));
+            }
+            other => panic!("{method:?}: {other:?}"),
+        }
+        let e = solve(
+            &mut Breaks { at: 0.5, nan: true },
+            method,
+            0.0,
+            &[1.0, 0.0],
+            1.0,
+            &opts,
+        )
+        .unwrap_err();
+        match e {
+            IntegratorError::NonFiniteState { t, .. }
+            | IntegratorError::StepSizeTooSmall { t, .. } => {
+                assert!(t >= 0.49 && t < 0.6, "{method:?} at {t}")
+            }
+            IntegratorError::NewtonFailure { t, .. } => assert!(t >= 0.49 && t < 0.6),
+            other => panic!("{method:?}: {other:?}"),
+        }
+    }
+}
+
+/// ẏ = −y³ + 10: Newton from a poor Jacobian at a huge fixed step cannot converge.
+struct Cubic;
+
+impl OdeSystem for Cubic {
+    fn len(&self) -> usize {
+        1
+    }
+    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+        dy[0] = -y[0] * y[0] * y[0] * 1e3 + 1e9 * (y[0] * 10.0).sin();
+        Ok(())
+    }
+}
+
+#[test]
+fn newton_failure_at_a_fixed_step_is_an_error() {
+    let e = solve(
+        &mut Cubic,
+        Method::TrBdf2,
+        0.0,
+        &[1.0],
+        1.0,
+        &Options::default().fixed(0.5),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, IntegratorError::NewtonFailure { t, .. } if t == 0.0),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("Newton"), "{e}");
+}
+
+#[test]
+fn bad_options_and_initial_conditions_are_named() {
+    let mut sys = BlowUp;
+    let cases: Vec<(Options, Method, &str)> = vec![
+        (
+            Options {
+                rtol: -1.0,
+                ..Options::default()
+            },
+            Method::DormandPrince54,
+            "rtol",
+        ),
+        (
+            Options {
+                atol: f64::NAN,
+                ..Options::default()
+            },
+            Method::DormandPrince54,
+            "atol",
+        ),
+        (Options::default(), Method::Rk4, "fixed_step"),
+        (
+            Options::default().fixed(0.0),
+            Method::DormandPrince54,
+            "fixed_step",
+        ),
+        (
+            Options {
+                max_step: 0.0,
+                ..Options::default()
+            },
+            Method::TrBdf2,
+            "max_step",
+        ),
+        (
+            Options::default().output_every(-1.0),
+            Method::TrBdf2,
+            "output_step",
+        ),
+        (
+            Options {
+                event_samples: 0,
+                ..Options::default()
+            },
+            Method::TrBdf2,
+            "event_samples",
+        ),
+    ];
+    for (opts, method, field) in cases {
+        let e = solve(&mut sys, method, 0.0, &[0.5], 0.1, &opts).unwrap_err();
+        assert!(
+            matches!(&e, IntegratorError::InvalidOption { option, .. } if *option == field),
+            "{field}: {e:?}"
+        );
+    }
+    let e = solve(
+        &mut sys,
+        Method::DormandPrince54,
+        0.0,
+        &[0.5, 1.0],
+        0.1,
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("length 2"), "{e}");
+    let e = solve(
+        &mut sys,
+        Method::DormandPrince54,
+        0.0,
+        &[f64::NAN],
+        0.1,
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("y0[0]"), "{e}");
+    let e = solve(
+        &mut sys,
+        Method::DormandPrince54,
+        1.0,
+        &[0.5],
+        0.0,
+        &Options::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, IntegratorError::InvalidInitialCondition(_)),
+        "{e:?}"
+    );
+    // Symplectic Euler needs q̇ = v.
+    let e = solve(
+        &mut sys,
+        Method::SemiImplicitEuler,
+        0.0,
+        &[0.5],
+        0.1,
+        &Options::default().fixed(0.01),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("second-order"), "{e}");
+}
+
+#[test]
+fn the_step_budget_is_an_error_not_a_hang() {
+    let opts = Options {
+        max_steps: 50,
+        ..Options::with_tolerances(1e-12, 1e-14)
+    };
+    let e = solve(
+        &mut BlowUp,
+        Method::DormandPrince54,
+        0.0,
+        &[1.0],
+        0.9,
+        &opts,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, IntegratorError::TooManySteps { max_steps: 50, t } if t < 0.9),
+        "{e:?}"
+    );
+    // A minimum step above what the tolerance needs is reported too.
+    let opts = Options {
+        min_step: Some(0.05),
+        initial_step: Some(0.1),
+        ..Options::with_tolerances(1e-12, 1e-14)
+    };
+    let e = solve(
+        &mut BlowUp,
+        Method::DormandPrince54,
+        0.0,
+        &[1.0],
+        0.9,
+        &opts,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, IntegratorError::StepSizeTooSmall { h_min, .. } if h_min == 0.05),
+        "{e:?}"
+    );
+}
