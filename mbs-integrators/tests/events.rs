@@ -54,7 +54,7 @@ fn impact_times(h0: f64, e: f64, count: usize) -> Vec<f64> {
 
 fn bounce(e: f64) -> impl FnMut(&mbs_integrators::Event, &mut [f64]) -> EventAction {
     move |_, y| {
-        y[1] = -e * y[1];
+        y[1] *= -e;
         y[0] = 0.0;
         EventAction::Reset
     }

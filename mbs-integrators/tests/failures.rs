@@ -107,9 +107,9 @@ fn system_errors_and_nan_are_reported_with_their_time() {
         match e {
             IntegratorError::NonFiniteState { t, .. }
             | IntegratorError::StepSizeTooSmall { t, .. } => {
-                assert!(t >= 0.49 && t < 0.6, "{method:?} at {t}")
+                assert!((0.49..0.6).contains(&t), "{method:?} at {t}")
             }
-            IntegratorError::NewtonFailure { t, .. } => assert!(t >= 0.49 && t < 0.6),
+            IntegratorError::NewtonFailure { t, .. } => assert!((0.49..0.6).contains(&t)),
             other => panic!("{method:?}: {other:?}"),
         }
     }
