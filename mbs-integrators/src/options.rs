@@ -18,7 +18,9 @@ pub enum Method {
     /// and implementation of Hosea & Shampine (1996): a trapezoidal stage then a BDF2 stage
     /// sharing one iteration matrix, modified Newton with the Jacobian reused across steps,
     /// second order, for stiff problems (felt contact). Fixed step if
-    /// [`Options::fixed_step`] is set.
+    /// [`Options::fixed_step`] is set. Its error control is per step, so on problems that do
+    /// not damp errors the global error grows like `rtol^(2/3)`: ask for a tighter `rtol`
+    /// than the accuracy wanted.
     TrBdf2,
 }
 
@@ -55,7 +57,8 @@ pub struct Options {
     pub max_step: f64,
     /// A fixed step size: required by the fixed-step methods, and turns error control off
     /// for the adaptive ones (useful to measure convergence, or for smooth
-    /// finite-difference sensitivities).
+    /// finite-difference sensitivities). TR-BDF2 still solves its stages to a precision
+    /// set by `rtol` and `atol`.
     pub fixed_step: Option<f64>,
     /// Maximum number of accepted steps.
     pub max_steps: usize,

@@ -156,10 +156,11 @@ pub(crate) fn hermite(
 }
 
 /// The step actually taken towards `t_max`: `h`, or what is left when that is within a
-/// hair of `h` (so no sliver step remains).
+/// millionth of `h` (so no sliver step remains, even after the round-off of many fixed
+/// steps has accumulated in `t`).
 pub(crate) fn clip_step(t: f64, h: f64, t_max: f64) -> (f64, bool) {
     let left = t_max - t;
-    if h >= left * (1.0 - 1e-12) {
+    if h >= left * (1.0 - 1e-6) {
         (left, true)
     } else {
         (h, false)

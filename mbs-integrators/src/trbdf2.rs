@@ -31,10 +31,16 @@ const W: f64 = SQRT2 / 4.0;
 const E0: f64 = (1.0 - 4.0 * W) / 3.0;
 const E1: f64 = 1.0 / 3.0;
 const E2: f64 = -2.0 * D / 3.0;
-/// Newton: maximum iterations per stage, and the convergence threshold on the weighted
-/// norm of the remaining correction.
+/// Newton: maximum iterations per stage (more with a fixed step, which cannot shrink
+/// instead), and the convergence threshold on the weighted norm of the remaining
+/// correction. With a fixed step the tolerances still set how exactly the stages are
+/// solved.
 const NEWTON_MAX: usize = 8;
+const NEWTON_MAX_FIXED: usize = 20;
 const NEWTON_TOL: f64 = 0.03;
+/// A Newton contraction rate above this marks the Jacobian stale: it is re-evaluated at
+/// the start of the next step (Hairer & Wanner's RADAU5 uses the same idea).
+const SLOW_RATE: f64 = 0.1;
 
 pub(crate) struct TrBdf2 {
     ctl: Control,
@@ -62,6 +68,10 @@ pub(crate) struct TrBdf2 {
     lu: Lu,
     /// The `h d` of the current factorisation (NaN when none).
     lu_c: f64,
+    /// Which stage the last Newton failure was in.
+    failed_in_end_stage: bool,
+    /// Whether Newton converged slowly in the current step.
+    slow: bool,
 }
 
 enum Stage {
@@ -96,20 +106,35 @@ impl TrBdf2 {
             jac_fresh: false,
             lu: Lu::new(n),
             lu_c: f64::NAN,
+            failed_in_end_stage: false,
+            slow: false,
         }
     }
 
-    /// J at (t, y): analytic if the system has one, else forward differences.
+    /// J at the start of the step: analytic if the system has one, else forward
+    /// differences.
     fn update_jacobian(&mut self, sys: &mut dyn OdeSystem, st: &mut Stats) -> Result<()> {
+        let (t, y, f) = (self.t, self.y.clone(), self.f.clone());
+        self.jacobian_at(sys, t, &y, &f, st)
+    }
+
+    /// J at `(t, y)` where `f = f(t, y)`.
+    fn jacobian_at(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        t: f64,
+        y: &[f64],
+        f: &[f64],
+        st: &mut Stats,
+    ) -> Result<()> {
         st.jacobian_evals += 1;
-        let t = self.t;
         if sys.has_jacobian() {
-            sys.jacobian(t, &self.y, &mut self.jac)
+            sys.jacobian(t, y, &mut self.jac)
                 .map_err(|source| IntegratorError::System { t, source })?;
         } else {
-            let mut yp = self.y.clone();
+            let mut yp = y.to_vec();
             for j in 0..self.n {
-                let yj = self.y[j];
+                let yj = y[j];
                 let dj = f64::EPSILON.sqrt() * yj.abs().max(1e-5);
                 yp[j] = yj + dj;
                 let dj = yp[j] - yj;
@@ -117,7 +142,7 @@ impl TrBdf2 {
                     return Err(non_finite(t, &self.jac_tmp));
                 }
                 for i in 0..self.n {
-                    self.jac[(i, j)] = (self.jac_tmp[i] - self.f[i]) / dj;
+                    self.jac[(i, j)] = (self.jac_tmp[i] - f[i]) / dj;
                 }
                 yp[j] = yj;
             }
@@ -163,7 +188,12 @@ impl TrBdf2 {
     ) -> Result<Stage> {
         let mut prev = f64::INFINITY;
         let mut rate: f64 = 1.0;
-        for k in 0..NEWTON_MAX {
+        let max_iterations = if self.ctl.fixed.is_some() {
+            NEWTON_MAX_FIXED
+        } else {
+            NEWTON_MAX
+        };
+        for k in 0..max_iterations {
             st.newton_iterations += 1;
             let z = if which_end {
                 &self.z_end
@@ -195,6 +225,9 @@ impl TrBdf2 {
                 if rate >= 0.9 {
                     return Ok(Stage::Failed);
                 }
+                if rate > SLOW_RATE {
+                    self.slow = true;
+                }
             }
             // Remaining error ≈ rate/(1 − rate) · ‖δ‖ once the rate is known.
             let remaining = if k > 0 {
@@ -218,8 +251,30 @@ impl TrBdf2 {
         Ok(Stage::Failed)
     }
 
+    /// A Jacobian at the iterate where Newton just failed (the stage point, with `fz` its
+    /// derivative), for problems whose Jacobian changes fast within a step.
+    fn jacobian_at_failure(
+        &mut self,
+        sys: &mut dyn OdeSystem,
+        h: f64,
+        st: &mut Stats,
+    ) -> Result<bool> {
+        let (ts, z) = if self.failed_in_end_stage {
+            (self.t + h, self.z_end.clone())
+        } else {
+            (self.t + GAMMA * h, self.z_gamma.clone())
+        };
+        let mut fz = vec![0.0; self.n];
+        if z.iter().any(|v| !v.is_finite()) || !eval(sys, ts, &z, &mut fz, st)? {
+            return Ok(false);
+        }
+        self.jacobian_at(sys, ts, &z, &fz, st)?;
+        Ok(true)
+    }
+
     /// Both stages with step h. Ok(false) when Newton failed.
     fn attempt(&mut self, sys: &mut dyn OdeSystem, h: f64, st: &mut Stats) -> Result<bool> {
+        self.slow = false;
         let c = h * D;
         self.factor(c, st)?;
         let n = self.n;
@@ -229,6 +284,7 @@ impl TrBdf2 {
             self.z_gamma[i] = self.y[i] + GAMMA * h * self.f[i];
         }
         if let Stage::Failed = self.newton(sys, self.t + GAMMA * h, c, false, st)? {
+            self.failed_in_end_stage = false;
             return Ok(false);
         }
         self.f_gamma.copy_from_slice(&self.fz);
@@ -239,6 +295,7 @@ impl TrBdf2 {
             self.z_end[i] = self.y[i] + (self.z_gamma[i] - self.y[i]) / GAMMA;
         }
         if let Stage::Failed = self.newton(sys, self.t + h, c, true, st)? {
+            self.failed_in_end_stage = true;
             return Ok(false);
         }
         self.f_end.copy_from_slice(&self.fz);
@@ -272,16 +329,29 @@ impl Stepper for TrBdf2 {
             self.update_jacobian(sys, st)?;
         }
         let mut rejected_once = false;
+        // Remedies tried at this step size: 0 none, 1 fresh Jacobian at the step start,
+        // 2 and more: Jacobians at the failing stage points (fixed step only, up to 4).
+        let mut remedies = 0;
         loop {
             let h_min = self.ctl.h_min(self.t);
             let (h, _) = clip_step(self.t, self.h.min(self.ctl.h_max), t_max);
             if !self.attempt(sys, h, st)? {
                 st.newton_failures += 1;
-                if !self.jac_fresh {
+                if !self.jac_fresh && remedies == 0 {
                     // First remedy: a Jacobian at the current point, same step.
+                    remedies = 1;
                     self.update_jacobian(sys, st)?;
                     continue;
                 }
+                if remedies < 4 && self.ctl.fixed.is_some() {
+                    // Then, when the step cannot shrink: a Jacobian where Newton
+                    // struggled (the stage point).
+                    remedies = remedies.max(1) + 1;
+                    if self.jacobian_at_failure(sys, h, st)? {
+                        continue;
+                    }
+                }
+                remedies = 0;
                 if self.ctl.fixed.is_some() || 0.25 * h < h_min {
                     return Err(IntegratorError::NewtonFailure { t: self.t, h });
                 }
@@ -369,6 +439,9 @@ impl TrBdf2 {
         self.t_prev = self.t;
         self.t += h;
         self.jac_fresh = false;
+        if self.slow {
+            self.jac_valid = false;
+        }
         st.steps += 1;
     }
 }

@@ -115,15 +115,16 @@ fn system_errors_and_nan_are_reported_with_their_time() {
     }
 }
 
-/// ẏ = −y³ + 10: Newton from a poor Jacobian at a huge fixed step cannot converge.
-struct Cubic;
+/// ẏ = 1 + y², y(0) = 1 (y = tan(t + π/4)). With h = 1 the trapezoidal stage
+/// `z = ψ + c (1 + z²)` (c = h d ≈ 0.29, ψ ≈ 1.59) has no real root: Newton cannot converge.
+struct Riccati;
 
-impl OdeSystem for Cubic {
+impl OdeSystem for Riccati {
     fn len(&self) -> usize {
         1
     }
     fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
-        dy[0] = -y[0] * y[0] * y[0] * 1e3 + 1e9 * (y[0] * 10.0).sin();
+        dy[0] = 1.0 + y[0] * y[0];
         Ok(())
     }
 }
@@ -131,12 +132,12 @@ impl OdeSystem for Cubic {
 #[test]
 fn newton_failure_at_a_fixed_step_is_an_error() {
     let e = solve(
-        &mut Cubic,
+        &mut Riccati,
         Method::TrBdf2,
         0.0,
         &[1.0],
         1.0,
-        &Options::default().fixed(0.5),
+        &Options::default().fixed(1.0),
     )
     .unwrap_err();
     assert!(
@@ -285,4 +286,57 @@ fn the_step_budget_is_an_error_not_a_hang() {
         matches!(e, IntegratorError::StepSizeTooSmall { h_min, .. } if h_min == 0.05),
         "{e:?}"
     );
+}
+
+/// ẏ = −2 t y², y(0) = 1: y = 1 / (1 + t²). Its Jacobian −4 t y vanishes at t = 0.
+struct VanishingJacobian;
+
+impl OdeSystem for VanishingJacobian {
+    fn len(&self) -> usize {
+        1
+    }
+    fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+        dy[0] = -2.0 * t * y[0] * y[0];
+        Ok(())
+    }
+}
+
+/// Regression (integrator test review): a fixed-step TR-BDF2 failed Newton on this easy
+/// problem because the Jacobian at the step start is zero; it now retries with the
+/// Jacobian at the stage point.
+#[test]
+fn fixed_step_newton_recovers_when_the_start_jacobian_is_useless() {
+    for rtol in [1e-6, 1e-10] {
+        let opts = Options::with_tolerances(rtol, 1e-2 * rtol).fixed(0.5);
+        let sol = solve(
+            &mut VanishingJacobian,
+            Method::TrBdf2,
+            0.0,
+            &[1.0],
+            2.0,
+            &opts,
+        )
+        .unwrap();
+        // Second order at h = 0.5: a few per cent.
+        assert!((sol.y_final[0] - 0.2).abs() < 0.02, "{}", sol.y_final[0]);
+        assert_eq!(sol.stats.steps, 4);
+    }
+}
+
+/// Regression (integrator test review): fixed steps used to leave a sliver step of ~1e-12 s
+/// at the end as round-off accumulated in t.
+#[test]
+fn fixed_steps_do_not_leave_a_sliver_at_the_end() {
+    let opts = Options::default().fixed(0.1);
+    let sol = solve(
+        &mut VanishingJacobian,
+        Method::Rk4,
+        0.0,
+        &[1.0],
+        100.0,
+        &opts,
+    )
+    .unwrap();
+    assert_eq!(sol.stats.steps, 1000);
+    assert_eq!(sol.t_final, 100.0);
 }
