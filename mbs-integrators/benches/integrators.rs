@@ -11,36 +11,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use mbs_core::System;
 use mbs_core::benchmarks::planar_chain;
-use mbs_integrators::{Method, MultibodyOde, OdeSystem, Options, SystemError, solve};
-
-struct Robertson;
-
-impl OdeSystem for Robertson {
-    fn len(&self) -> usize {
-        3
-    }
-    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
-        dy[0] = -0.04 * y[0] + 1e4 * y[1] * y[2];
-        dy[1] = 0.04 * y[0] - 1e4 * y[1] * y[2] - 3e7 * y[1] * y[1];
-        dy[2] = 3e7 * y[1] * y[1];
-        Ok(())
-    }
-}
-
-struct VanDerPol {
-    eps: f64,
-}
-
-impl OdeSystem for VanDerPol {
-    fn len(&self) -> usize {
-        2
-    }
-    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
-        dy[0] = y[1];
-        dy[1] = ((1.0 - y[0] * y[0]) * y[1] - y[0]) / self.eps;
-        Ok(())
-    }
-}
+use mbs_integrators::problems::{Robertson, VanDerPol};
+use mbs_integrators::{Method, MultibodyOde, OdeSystem, Options, solve};
 
 fn report(
     name: &str,
@@ -91,10 +63,10 @@ fn integrators(c: &mut Criterion) {
     });
 
     let stiff = Options::with_tolerances(1e-6, 1e-10);
-    let y0 = [1.0, 0.0, 0.0];
+    let y0 = Robertson::Y0;
     report(
         "robertson t=40 TR-BDF2",
-        &mut Robertson,
+        &mut Robertson::default(),
         Method::TrBdf2,
         &y0,
         40.0,
@@ -102,7 +74,7 @@ fn integrators(c: &mut Criterion) {
     );
     report(
         "robertson t=40 DOPRI5",
-        &mut Robertson,
+        &mut Robertson::default(),
         Method::DormandPrince54,
         &y0,
         40.0,
@@ -111,7 +83,7 @@ fn integrators(c: &mut Criterion) {
     c.bench_function("robertson_trbdf2_t40", |b| {
         b.iter(|| {
             solve(
-                &mut Robertson,
+                &mut Robertson::default(),
                 Method::TrBdf2,
                 0.0,
                 black_box(&y0),
@@ -125,7 +97,7 @@ fn integrators(c: &mut Criterion) {
     c.bench_function("robertson_dopri5_t40", |b| {
         b.iter(|| {
             solve(
-                &mut Robertson,
+                &mut Robertson::default(),
                 Method::DormandPrince54,
                 0.0,
                 black_box(&y0),
@@ -138,7 +110,10 @@ fn integrators(c: &mut Criterion) {
     });
 
     let vdp = Options::with_tolerances(1e-6, 1e-6);
-    let mut sys = VanDerPol { eps: 1e-6 };
+    let mut sys = VanDerPol {
+        eps: 1e-6,
+        analytic_jacobian: false,
+    };
     report(
         "van der Pol eps=1e-6 t=2 TR-BDF2",
         &mut sys,

@@ -55,6 +55,7 @@ mod linalg;
 mod multibody;
 mod ode;
 mod options;
+pub mod problems;
 mod solution;
 mod stepper;
 mod trbdf2;

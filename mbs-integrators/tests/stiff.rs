@@ -2,73 +2,10 @@
 //! published reference solutions, the work TR-BDF2 saves over an explicit method on them,
 //! and L-stability on a stiff linear mass-spring chain with an exact solution.
 
+use mbs_integrators::problems::{Robertson, VanDerPol};
 use mbs_integrators::{
     IntegratorError, Method, OdeSystem, Options, Solution, Stats, SystemError, solve,
 };
-use nalgebra::DMatrix;
-
-/// Robertson's chemical kinetics (Hairer & Wanner, *Solving ODEs II*, §IV.1; the IVP
-/// Test Set's ROBER), optionally with its analytic Jacobian.
-struct Robertson {
-    analytic: bool,
-}
-
-impl OdeSystem for Robertson {
-    fn len(&self) -> usize {
-        3
-    }
-    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
-        let (a, b) = (0.04 * y[0], 1e4 * y[1] * y[2]);
-        let c = 3e7 * y[1] * y[1];
-        dy[0] = -a + b;
-        dy[1] = a - b - c;
-        dy[2] = c;
-        Ok(())
-    }
-    fn has_jacobian(&self) -> bool {
-        self.analytic
-    }
-    fn jacobian(&mut self, _t: f64, y: &[f64], j: &mut DMatrix<f64>) -> Result<(), SystemError> {
-        j[(0, 0)] = -0.04;
-        j[(0, 1)] = 1e4 * y[2];
-        j[(0, 2)] = 1e4 * y[1];
-        j[(1, 0)] = 0.04;
-        j[(1, 1)] = -1e4 * y[2] - 6e7 * y[1];
-        j[(1, 2)] = -1e4 * y[1];
-        j[(2, 0)] = 0.0;
-        j[(2, 1)] = 6e7 * y[1];
-        j[(2, 2)] = 0.0;
-        Ok(())
-    }
-}
-
-/// Van der Pol's equation in the IVP Test Set's scaled form (VDPOL):
-/// `y1' = y2`, `y2' = ((1 − y1²) y2 − y1) / ε`.
-struct VanDerPol {
-    eps: f64,
-    analytic: bool,
-}
-
-impl OdeSystem for VanDerPol {
-    fn len(&self) -> usize {
-        2
-    }
-    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
-        dy[0] = y[1];
-        dy[1] = ((1.0 - y[0] * y[0]) * y[1] - y[0]) / self.eps;
-        Ok(())
-    }
-    fn has_jacobian(&self) -> bool {
-        self.analytic
-    }
-    fn jacobian(&mut self, _t: f64, y: &[f64], j: &mut DMatrix<f64>) -> Result<(), SystemError> {
-        j[(0, 0)] = 0.0;
-        j[(0, 1)] = 1.0;
-        j[(1, 0)] = (-2.0 * y[0] * y[1] - 1.0) / self.eps;
-        j[(1, 1)] = (1.0 - y[0] * y[0]) / self.eps;
-        Ok(())
-    }
-}
 
 fn print_stats(what: &str, s: &Stats) {
     println!(
@@ -94,16 +31,9 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
 }
 
-const ROBER_Y0: [f64; 3] = [1.0, 0.0, 0.0];
-/// Hairer & Wanner's values at t = 40.
-const ROBER_40: [f64; 3] = [0.7158270687, 9.185534764e-6, 0.2841637457];
-/// The IVP Test Set's reference at t = 1e11 (digits as published).
-#[allow(clippy::excessive_precision)]
-const ROBER_1E11: [f64; 3] = [
-    0.2083340149701255e-7,
-    0.8333360770334713e-13,
-    0.9999999791665050,
-];
+const ROBER_Y0: [f64; 3] = Robertson::Y0;
+const ROBER_40: [f64; 3] = Robertson::AT_40;
+const ROBER_1E11: [f64; 3] = Robertson::AT_1E11;
 
 fn robertson_opts() -> Options {
     Options {
@@ -114,7 +44,9 @@ fn robertson_opts() -> Options {
 
 fn rober(method: Method, analytic: bool, t_end: f64, opts: &Options) -> Solution {
     solve(
-        &mut Robertson { analytic },
+        &mut Robertson {
+            analytic_jacobian: analytic,
+        },
         method,
         0.0,
         &ROBER_Y0,
@@ -215,7 +147,10 @@ fn vdp(
     opts: &Options,
 ) -> Result<Solution, IntegratorError> {
     solve(
-        &mut VanDerPol { eps, analytic },
+        &mut VanDerPol {
+            eps,
+            analytic_jacobian: analytic,
+        },
         method,
         0.0,
         &[2.0, 0.0],
