@@ -1,13 +1,26 @@
-//! # mbs-contact (stub)
+//! # mbs-contact: contact geometry and constitutive laws
 //!
-//! **Not built yet.** This crate will hold the planar contact geometry (circles, lines,
-//! segments, arcs and profiles made of them) with closed-form narrow phase in `f64`, the
-//! normal and tangential constitutive laws (Kelvin–Voigt, Hertz, Hunt–Crossley,
-//! Lankarani–Nikravesh, hysteretic felt, Stulov; regularized Coulomb, Stribeck), material
-//! presets, and a contact force element for the [`mbs_core`] `System`.
+//! The piano action's behaviour lives in its contacts: felt, buckskin, cloth and wood
+//! pressed together, and the hammer felt on the string. This crate makes contacts a
+//! pluggable part of the planar multibody framework:
 //!
-//! Until then it only re-exports the core so the workspace layout is in place.
+//! - [`geometry`]: circles, half-planes, segments and circular arcs (convex or concave),
+//!   and profiles made of them, with the closed-form narrow phase of every pair in `f64`
+//!   (signed gap, normal, nearest points);
+//! - [`laws`]: normal laws (Kelvin–Voigt, Hertz, Hunt–Crossley, Lankarani–Nikravesh,
+//!   hysteretic power-law felt, Stulov's hereditary felt) and friction laws;
+//! - [`materials`]: presets with their sources;
+//! - [`Contact`]: a force element for `mbs_core::System`, mapping contact forces to the
+//!   bodies, with the gap as switching function for event location.
 
 #![warn(missing_docs)]
 
-pub use mbs_core;
+mod element;
+mod error;
+pub mod geometry;
+pub mod laws;
+pub mod materials;
+
+pub use element::{Contact, ContactOutput, ContactSide};
+pub use error::{ContactError, Result};
+pub use geometry::{ArcSide, Proximity, Shape, proximity};

@@ -495,6 +495,27 @@ impl System {
         Ok(())
     }
 
+    /// The context element `element` sees at `(t, x)` (kinematics computed): for reading an
+    /// element's own outputs (a contact's gap and forces, a spring's length) at a state.
+    pub fn element_context<'a>(
+        &'a self,
+        ws: &'a mut Workspace,
+        t: f64,
+        x: &'a [f64],
+        element: usize,
+    ) -> Result<ForceContext<'a>> {
+        let states = self
+            .entries
+            .get(element)
+            .map(|en| en.states.clone())
+            .ok_or_else(|| CoreError::UnknownName {
+                what: "element index",
+                name: element.to_string(),
+            })?;
+        self.prepare(ws, t, x)?;
+        Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[states]))
+    }
+
     /// The energy of state `x` at time `t`: kinetic, gravitational and stored in elements.
     pub fn energy(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<Energy> {
         self.prepare(ws, t, x)?;

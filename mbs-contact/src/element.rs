@@ -1,0 +1,278 @@
+//! [`Contact`]: a contact between two bodies (or a body and the ground) as a force element
+//! of an `mbs_core::System`.
+
+use std::sync::Arc;
+
+use mbs_core::{BodyId, Crossing, ForceContext, ForceElement, Loads, Model};
+
+use crate::error::{ContactError, Result};
+use crate::geometry::{Proximity, Shape, proximity};
+use crate::laws::{NormalLaw, TangentialLaw};
+
+/// One side of a contact: the frame its shapes are given in (`None` for the ground, shapes
+/// then in world coordinates) and the shapes (a profile when there are several).
+#[derive(Clone, Debug)]
+pub struct ContactSide {
+    /// Frame name, `None` for the ground.
+    pub frame: Option<String>,
+    /// Shapes in the frame's coordinates.
+    pub shapes: Vec<Shape>,
+}
+
+impl ContactSide {
+    /// Shapes fixed to the named frame.
+    pub fn on(frame: &str, shapes: Vec<Shape>) -> Self {
+        Self {
+            frame: Some(frame.to_string()),
+            shapes,
+        }
+    }
+
+    /// Shapes fixed to the ground (world coordinates).
+    pub fn ground(shapes: Vec<Shape>) -> Self {
+        Self {
+            frame: None,
+            shapes,
+        }
+    }
+}
+
+/// A side resolved on a model: body and shapes in the body's joint frame.
+#[derive(Clone, Debug)]
+struct ResolvedSide {
+    body: BodyId,
+    shapes: Vec<Shape>,
+}
+
+/// What a contact does at one state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactOutput {
+    /// Whether the surfaces overlap and the force is positive.
+    pub active: bool,
+    /// Signed gap (m).
+    pub gap: f64,
+    /// Normal force (N, ≥ 0) pushing B away from A.
+    pub normal_force: f64,
+    /// Tangential force on B along the tangent (N).
+    pub tangential_force: f64,
+    /// Power of the contact forces on the two bodies (W): negative when the contact absorbs
+    /// energy.
+    pub power: f64,
+    /// Contact point (world), midway between the two surfaces.
+    pub point: [f64; 2],
+    /// Unit normal from A toward B (world).
+    pub normal: [f64; 2],
+}
+
+/// A contact between the shapes of two sides, with a normal law and optional friction. The
+/// forces act at the midpoint of the two nearest surface points, equal and opposite on the
+/// two bodies. Its switching function is the gap, so an integrator can locate onset and
+/// release.
+#[derive(Clone)]
+pub struct Contact {
+    name: String,
+    sides: [ResolvedSide; 2],
+    normal: Arc<dyn NormalLaw>,
+    friction: Option<Arc<dyn TangentialLaw>>,
+}
+
+impl std::fmt::Debug for Contact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Contact")
+            .field("name", &self.name)
+            .field("normal", &self.normal)
+            .field("friction", &self.friction)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Contact {
+    /// A contact named `name` between sides `a` and `b` under `normal`. Fails on an unknown
+    /// frame, an empty side, both sides on the ground, or a pair of shapes that cannot touch
+    /// (two lines, two concave arcs).
+    pub fn new(
+        model: &Model,
+        name: &str,
+        a: ContactSide,
+        b: ContactSide,
+        normal: impl NormalLaw + 'static,
+    ) -> Result<Self> {
+        let sides = [resolve(model, name, &a)?, resolve(model, name, &b)?];
+        if sides[0].body == BodyId::GROUND && sides[1].body == BodyId::GROUND {
+            return Err(ContactError::UnsupportedPair {
+                contact: name.into(),
+                message: "both sides are on the ground".into(),
+            });
+        }
+        for sa in &sides[0].shapes {
+            for sb in &sides[1].shapes {
+                proximity(sa, sb).map_err(|e| ContactError::UnsupportedPair {
+                    contact: name.into(),
+                    message: e.to_string(),
+                })?;
+            }
+        }
+        Ok(Self {
+            name: format!("contact '{name}'"),
+            sides,
+            normal: Arc::new(normal),
+            friction: None,
+        })
+    }
+
+    /// The same contact with friction.
+    pub fn with_friction(self, law: impl TangentialLaw + 'static) -> Self {
+        Self {
+            friction: Some(Arc::new(law)),
+            ..self
+        }
+    }
+
+    /// The nearest points of the two sides (the pair of shapes with the smallest gap), in
+    /// world coordinates, from the poses in `ctx`.
+    pub fn proximity(&self, ctx: &ForceContext<'_>) -> Proximity {
+        let (pa, pb) = (
+            ctx.body_pose(self.sides[0].body),
+            ctx.body_pose(self.sides[1].body),
+        );
+        let mut best: Option<Proximity> = None;
+        for sa in &self.sides[0].shapes {
+            let wa = sa.placed(&pa);
+            for sb in &self.sides[1].shapes {
+                // Pairs were checked at construction.
+                if let Ok(p) = proximity(&wa, &sb.placed(&pb))
+                    && best.is_none_or(|b| p.gap < b.gap)
+                {
+                    best = Some(p);
+                }
+            }
+        }
+        best.unwrap_or(Proximity {
+            gap: f64::INFINITY,
+            normal: [1.0, 0.0],
+            point_a: [0.0, 0.0],
+            point_b: [0.0, 0.0],
+        })
+    }
+
+    /// Gap, forces and power at the state in `ctx`; `rates` receives the normal law's state
+    /// rates.
+    fn compute(&self, ctx: &ForceContext<'_>, rates: &mut [f64]) -> ContactOutput {
+        let p = self.proximity(ctx);
+        let mid = [
+            0.5 * (p.point_a[0] + p.point_b[0]),
+            0.5 * (p.point_a[1] + p.point_b[1]),
+        ];
+        let [a, b] = &self.sides;
+        let va = velocity_at(ctx, a.body, mid);
+        let vb = velocity_at(ctx, b.body, mid);
+        let vrel = [vb[0] - va[0], vb[1] - va[1]];
+        let n = p.normal;
+        let t = p.tangent();
+        // ġ = (v_B − v_A) · n ; slip = (v_B − v_A) · t
+        let gap_rate = vrel[0] * n[0] + vrel[1] * n[1];
+        let slip = vrel[0] * t[0] + vrel[1] * t[1];
+        let fn_ = if p.gap.is_finite() {
+            self.normal
+                .force(-p.gap, -gap_rate, ctx.states, rates)
+                .max(0.0)
+        } else {
+            rates.fill(0.0);
+            0.0
+        };
+        let ft = match &self.friction {
+            Some(f) if fn_ > 0.0 => f.force(fn_, slip),
+            _ => 0.0,
+        };
+        ContactOutput {
+            active: fn_ > 0.0,
+            gap: p.gap,
+            normal_force: fn_,
+            tangential_force: ft,
+            power: fn_ * gap_rate + ft * slip,
+            point: mid,
+            normal: n,
+        }
+    }
+
+    /// Gap, forces and power at the state in `ctx` (per-contact output).
+    pub fn output(&self, ctx: &ForceContext<'_>) -> ContactOutput {
+        let mut rates = vec![0.0; self.normal.state_count()];
+        self.compute(ctx, &mut rates)
+    }
+}
+
+fn resolve(model: &Model, contact: &str, side: &ContactSide) -> Result<ResolvedSide> {
+    if side.shapes.is_empty() {
+        return Err(ContactError::UnsupportedPair {
+            contact: contact.into(),
+            message: "a side has no shape".into(),
+        });
+    }
+    let (body, placement) = match &side.frame {
+        None => (BodyId::GROUND, mbs_core::Transform::IDENTITY),
+        Some(f) => {
+            let frame = model.frame(model.frame_id(f)?);
+            (frame.body, frame.placement)
+        }
+    };
+    Ok(ResolvedSide {
+        body,
+        shapes: side.shapes.iter().map(|s| s.placed(&placement)).collect(),
+    })
+}
+
+/// World velocity of the material point of `body` at the world point `p`.
+fn velocity_at(ctx: &ForceContext<'_>, body: BodyId, p: [f64; 2]) -> [f64; 2] {
+    let p_b = ctx.body_pose(body).inverse_transform_point(p);
+    ctx.point_velocity(body, p_b)
+}
+
+impl ForceElement for Contact {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn check_model(&self, model: &Model) -> mbs_core::Result<()> {
+        for s in &self.sides {
+            if s.body.index() >= model.nbodies() {
+                return Err(mbs_core::CoreError::InvalidParameter {
+                    item: self.name.clone(),
+                    message: "built for another model".into(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn state_count(&self) -> usize {
+        self.normal.state_count()
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, rates: &mut [f64]) {
+        let out = self.compute(ctx, rates);
+        if !out.active {
+            return;
+        }
+        let (n, t) = (out.normal, [-out.normal[1], out.normal[0]]);
+        // Force on B: F = Fn n + Ft t ; on A: −F, both at the contact point.
+        let f = [
+            out.normal_force * n[0] + out.tangential_force * t[0],
+            out.normal_force * n[1] + out.tangential_force * t[1],
+        ];
+        loads.add_force_at_point(self.sides[1].body, out.point, f);
+        loads.add_force_at_point(self.sides[0].body, out.point, [-f[0], -f[1]]);
+    }
+
+    fn switch_count(&self) -> usize {
+        1
+    }
+
+    fn switching_functions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
+        out[0] = self.proximity(ctx).gap;
+    }
+
+    fn switch_direction(&self, _k: usize) -> Crossing {
+        Crossing::Both
+    }
+}

@@ -1,0 +1,1 @@
+//! Material presets (being written).
