@@ -1,0 +1,167 @@
+//! The `Contact` force element in an `mbs_core::System`: action and reaction, the gap as
+//! switching function, per-contact output, profiles, ground contacts.
+
+use mbs_contact::laws::NormalLaw;
+use mbs_contact::{Contact, ContactSide, Shape};
+use mbs_core::{BodySpec, Force, ForceElement, JointKind, Loads, ModelBuilder, Placement, System};
+
+/// A linear spring law for these tests: F = k δ.
+#[derive(Debug)]
+struct Linear(f64);
+
+impl NormalLaw for Linear {
+    fn force(&self, delta: f64, _rate: f64, _s: &[f64], _r: &mut [f64]) -> f64 {
+        if delta > 0.0 { self.0 * delta } else { 0.0 }
+    }
+}
+
+/// Two free-ish bodies: a slider carrying a disc, and a pendulum carrying a bar.
+fn two_bodies() -> mbs_core::Model {
+    let mut b = ModelBuilder::new();
+    b.gravity([0.0, -9.81])
+        .add_link(
+            "slider",
+            None,
+            JointKind::Prismatic { axis: [1.0, 0.0] },
+            Placement::default(),
+            BodySpec::new(0.5, [0.0, 0.0], 1e-3),
+        )
+        .add_link(
+            "arm",
+            None,
+            JointKind::Revolute,
+            Placement::offset(0.3, 0.0),
+            BodySpec::rod(0.2, 0.4),
+        );
+    b.build().unwrap()
+}
+
+#[test]
+fn action_and_reaction_are_equal_and_opposite() {
+    let model = two_bodies();
+    let disc = Shape::circle([0.0, 0.0], 0.05).unwrap();
+    // The arm's lower face, from its tip back to the pivot (facing down when horizontal).
+    let face = Shape::segment([0.4, 0.0], [0.0, 0.0]).unwrap();
+    let contact = Contact::new(
+        &model,
+        "disc-arm",
+        ContactSide::on("slider", vec![disc]),
+        ContactSide::on("arm", vec![face]),
+        Linear(1e4),
+    )
+    .unwrap();
+    let mut system = System::new(model.clone());
+    let e = system.add_element(contact.clone()).unwrap();
+    let mut ws = system.workspace();
+    // Slider at x = 0.45 under the arm tilted slightly down: the disc presses the bar.
+    let x = [0.45, -0.1, 0.2, -0.3];
+    let ctx = system.element_context(&mut ws, 0.0, &x, e).unwrap();
+    let out = contact.output(&ctx);
+    assert!(
+        out.active && out.gap < 0.0 && out.normal_force > 0.0,
+        "{out:?}"
+    );
+    assert!((out.normal_force - 1e4 * -out.gap).abs() < 1e-9);
+    let mut tau = vec![0.0; 2];
+    let mut forces = vec![Force::ZERO; model.nbodies()];
+    let mut loads = Loads::new(&mut tau, &mut forces);
+    contact.apply(&ctx, &mut loads, &mut []);
+    let (fa, fb) = (forces[1], forces[2]);
+    // Equal and opposite forces, at the same point: the spatial forces cancel exactly.
+    assert!((fa.fx + fb.fx).abs() < 1e-12 && (fa.fy + fb.fy).abs() < 1e-12);
+    assert!((fa.n + fb.n).abs() < 1e-12, "moments {} {}", fa.n, fb.n);
+    // The force on the arm pushes it away from the disc, along the normal.
+    assert!(fb.fx * out.normal[0] + fb.fy * out.normal[1] > 0.0);
+}
+
+#[test]
+fn ground_contacts_profiles_and_the_gap_switch() {
+    let mut b = ModelBuilder::new();
+    b.gravity([0.0, -9.81]).add_link(
+        "ball",
+        None,
+        JointKind::Prismatic { axis: [0.0, 1.0] },
+        Placement::default(),
+        BodySpec::new(0.01, [0.0, 0.0], 1e-6),
+    );
+    let model = b.build().unwrap();
+    // A floor made of two faces (a profile), the ball a disc of radius 1 cm.
+    let floor = vec![
+        Shape::segment([-1.0, 0.0], [0.0, 0.0]).unwrap(),
+        Shape::segment([0.0, -0.002], [1.0, -0.002]).unwrap(),
+    ];
+    let contact = Contact::new(
+        &model,
+        "ball-floor",
+        ContactSide::ground(floor),
+        ContactSide::on("ball", vec![Shape::circle([0.0, 0.0], 0.01).unwrap()]),
+        Linear(100.0),
+    )
+    .unwrap();
+    let mut system = System::new(model);
+    let e = system.add_element(contact.clone()).unwrap();
+    assert_eq!(system.switch_len(), 1);
+    let mut ws = system.workspace();
+    let mut g = [0.0];
+    for (height, gap) in [(0.05, 0.04), (0.01, 0.0), (0.008, -0.002)] {
+        let state = [height, 0.0];
+        system
+            .switching_functions(&mut ws, 0.0, &state, &mut g)
+            .unwrap();
+        assert!((g[0] - gap).abs() < 1e-12, "height {height}: gap {}", g[0]);
+        let ctx = system.element_context(&mut ws, 0.0, &state, e).unwrap();
+        let out = contact.output(&ctx);
+        assert_eq!(out.active, gap < 0.0);
+        assert!((out.normal_force - 100.0 * (-gap).max(0.0)).abs() < 1e-12);
+    }
+    // Resting on the floor: the contact carries the weight at the compression m g / k.
+    let mut xdot = [0.0; 2];
+    let rest = 0.01 - 0.01 * 9.81 / 100.0;
+    system
+        .derivative(&mut ws, 0.0, &[rest, 0.0], &mut xdot)
+        .unwrap();
+    assert!(xdot[1].abs() < 1e-12, "acceleration at rest {}", xdot[1]);
+}
+
+#[test]
+fn contacts_that_cannot_work_are_refused() {
+    let model = two_bodies();
+    let c = Shape::circle([0.0, 0.0], 0.1).unwrap();
+    let l = Shape::line([0.0, 0.0], [0.0, 1.0]).unwrap();
+    let e = Contact::new(
+        &model,
+        "x",
+        ContactSide::ground(vec![c]),
+        ContactSide::ground(vec![c]),
+        Linear(1.0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("ground"), "{e}");
+    let e = Contact::new(
+        &model,
+        "x",
+        ContactSide::on("arm", vec![l]),
+        ContactSide::ground(vec![l]),
+        Linear(1.0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("contact 'x'"), "{e}");
+    let e = Contact::new(
+        &model,
+        "x",
+        ContactSide::on("nowhere", vec![c]),
+        ContactSide::ground(vec![l]),
+        Linear(1.0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("nowhere"), "{e}");
+    let e = Contact::new(
+        &model,
+        "x",
+        ContactSide::on("arm", vec![]),
+        ContactSide::ground(vec![l]),
+        Linear(1.0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("no shape"), "{e}");
+}
