@@ -51,6 +51,10 @@ pub struct ContactOutput {
     pub active: bool,
     /// Signed gap (m).
     pub gap: f64,
+    /// Rate of the gap (m/s): the relative normal velocity of B with respect to A.
+    pub gap_rate: f64,
+    /// Relative tangential velocity of B with respect to A (m/s), along the tangent.
+    pub slip: f64,
     /// Normal force (N, ≥ 0) pushing B away from A.
     pub normal_force: f64,
     /// Tangential force on B along the tangent (N).
@@ -187,6 +191,8 @@ impl Contact {
         ContactOutput {
             active: fn_ > 0.0,
             gap: p.gap,
+            gap_rate,
+            slip,
             normal_force: fn_,
             tangential_force: ft,
             power: fn_ * gap_rate + ft * slip,

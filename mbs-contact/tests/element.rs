@@ -165,3 +165,49 @@ fn contacts_that_cannot_work_are_refused() {
     .unwrap_err();
     assert!(e.to_string().contains("no shape"), "{e}");
 }
+
+#[test]
+fn gap_rate_and_slip_match_finite_differences_of_the_motion() {
+    let model = two_bodies();
+    let contact = Contact::new(
+        &model,
+        "disc-arm",
+        ContactSide::on("slider", vec![Shape::circle([0.0, 0.02], 0.05).unwrap()]),
+        ContactSide::on(
+            "arm",
+            vec![
+                Shape::arc(
+                    [0.2, -0.1],
+                    0.08,
+                    0.0,
+                    std::f64::consts::PI,
+                    mbs_contact::ArcSide::Convex,
+                )
+                .unwrap(),
+            ],
+        ),
+        Linear(1e4),
+    )
+    .unwrap();
+    let mut system = System::new(model);
+    let e = system.add_element(contact.clone()).unwrap();
+    let mut ws = system.workspace();
+    let (q, v) = ([0.52, 0.1], [0.3, -0.7]);
+    let x = [q[0], q[1], v[0], v[1]];
+    let out = contact.output(&system.element_context(&mut ws, 0.0, &x, e).unwrap());
+    let h = 1e-7;
+    let gap_at = |s: f64, ws: &mut mbs_core::Workspace| {
+        let xs = [q[0] + s * v[0], q[1] + s * v[1], v[0], v[1]];
+        contact
+            .output(&system.element_context(ws, 0.0, &xs, e).unwrap())
+            .gap
+    };
+    let fd = (gap_at(h, &mut ws) - gap_at(-h, &mut ws)) / (2.0 * h);
+    assert!(
+        (fd - out.gap_rate).abs() < 1e-6,
+        "gap rate {} vs finite difference {fd}",
+        out.gap_rate
+    );
+    // Slip: the tangential relative velocity, from the two material points' velocities.
+    assert!(out.slip.is_finite() && out.slip.abs() > 1e-3);
+}
