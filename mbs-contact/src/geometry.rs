@@ -228,6 +228,12 @@ fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     [a[0] - b[0], a[1] - b[1]]
 }
 
+/// Euclidean length; plain `sqrt` (lengths in a mechanism are far from overflow, and
+/// `hypot` costs several times more).
+fn norm(a: [f64; 2]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1]).sqrt()
+}
+
 fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[0] + a[1] * b[1]
 }
@@ -240,7 +246,7 @@ fn axpy(a: [f64; 2], k: f64, d: [f64; 2]) -> [f64; 2] {
 /// the centres coincide the direction is undefined; `fallback` is used.
 fn round_round(pa: [f64; 2], ra: f64, pb: [f64; 2], rb: f64, fallback: [f64; 2]) -> Proximity {
     let d = sub(pb, pa);
-    let dist = d[0].hypot(d[1]);
+    let dist = norm(d);
     let n = if dist > 1e-15 {
         [d[0] / dist, d[1] / dist]
     } else {
@@ -285,7 +291,7 @@ fn face_round(
 /// Unit direction and length of a segment.
 fn seg_frame(s: &Segment) -> ([f64; 2], f64, [f64; 2]) {
     let d = sub(s.b, s.a);
-    let len = d[0].hypot(d[1]);
+    let len = norm(d);
     let u = [d[0] / len, d[1] / len];
     // Outward normal: the direction turned a quarter counter-clockwise (faces left).
     (u, len, [-u[1], u[0]])
@@ -317,7 +323,7 @@ fn arc_mid_direction(a: &Arc) -> [f64; 2] {
 /// An arc (A) against a rounded point (`p`, `r`).
 fn arc_round(a: &Arc, p: [f64; 2], r: f64) -> Proximity {
     let d = sub(p, a.center);
-    let dist = d[0].hypot(d[1]);
+    let dist = norm(d);
     // Concentric: every direction is as good; take the middle of the span.
     let u = if dist > 1e-15 {
         [d[0] / dist, d[1] / dist]
@@ -505,7 +511,7 @@ fn arc_arc(x: &Arc, y: &Arc) -> Result<Proximity> {
         c.push(arc_round(y, e, 0.0).flipped());
     }
     let d = sub(y.center, x.center);
-    let dist = d[0].hypot(d[1]);
+    let dist = norm(d);
     if dist > 1e-15 {
         let u = [d[0] / dist, d[1] / dist];
         let up = u[1].atan2(u[0]);
