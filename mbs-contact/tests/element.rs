@@ -211,3 +211,103 @@ fn gap_rate_and_slip_match_finite_differences_of_the_motion() {
     // Slip: the tangential relative velocity, from the two material points' velocities.
     assert!(out.slip.is_finite() && out.slip.abs() > 1e-3);
 }
+
+#[test]
+fn contact_forces_map_to_generalized_forces_through_the_point_jacobians() {
+    let model = two_bodies();
+    let contact = Contact::new(
+        &model,
+        "disc-arm",
+        ContactSide::on("slider", vec![Shape::circle([0.0, 0.0], 0.05).unwrap()]),
+        ContactSide::on("arm", vec![Shape::segment([0.4, 0.0], [0.0, 0.0]).unwrap()]),
+        Linear(1e4),
+    )
+    .unwrap()
+    .with_friction(mbs_contact::laws::RegularizedCoulomb::new(0.3, 1e-3).unwrap());
+    let mut system = System::new(model.clone());
+    let e = system.add_element(contact.clone()).unwrap();
+    let mut ws = system.workspace();
+    let x = [0.45, -0.1, 0.2, -0.3];
+    let out = contact.output(&system.element_context(&mut ws, 0.0, &x, e).unwrap());
+    assert!(out.active && out.tangential_force != 0.0);
+    system.derivative(&mut ws, 0.0, &x, &mut [0.0; 4]).unwrap();
+    let tau = system.element_forces(&mut ws).to_vec();
+    // τ = J_B(p)ᵀ F − J_A(p)ᵀ F with F = Fn n + Ft t the force on B at the contact point p.
+    let (n, t) = (out.normal, [-out.normal[1], out.normal[0]]);
+    let f = [
+        out.normal_force * n[0] + out.tangential_force * t[0],
+        out.normal_force * n[1] + out.tangential_force * t[1],
+    ];
+    let data = ws.data();
+    let mut expect = [0.0; 2];
+    for (name, sign) in [("arm", 1.0), ("slider", -1.0)] {
+        let body = model.body_id(name).unwrap();
+        let p_b = data.body_pose(body).inverse_transform_point(out.point);
+        let mut j = nalgebra::DMatrix::zeros(2, 2);
+        mbs_core::point_jacobian(&model, data, body, p_b, &mut j).unwrap();
+        for k in 0..2 {
+            expect[k] += sign * (j[(0, k)] * f[0] + j[(1, k)] * f[1]);
+        }
+    }
+    for k in 0..2 {
+        assert!(
+            (tau[k] - expect[k]).abs() < 1e-9 * (1.0 + expect[k].abs()),
+            "τ[{k}] {} vs Jᵀ F {}",
+            tau[k],
+            expect[k]
+        );
+    }
+}
+
+#[test]
+fn the_integrator_locates_contact_onset_and_release() {
+    use mbs_integrators::{EventAction, Method, MultibodyOde, Options, solve_with_events};
+    // A 10 g disc dropped from 5 cm (centre height) onto a stiff floor, radius 1 cm.
+    let mut b = ModelBuilder::new();
+    b.gravity([0.0, -9.81]).add_link(
+        "ball",
+        None,
+        JointKind::Prismatic { axis: [0.0, 1.0] },
+        Placement::default(),
+        BodySpec::new(0.01, [0.0, 0.0], 1e-6),
+    );
+    let model = b.build().unwrap();
+    let contact = Contact::new(
+        &model,
+        "ball-floor",
+        ContactSide::ground(vec![Shape::line([0.0, 0.0], [0.0, 1.0]).unwrap()]),
+        ContactSide::on("ball", vec![Shape::circle([0.0, 0.0], 0.01).unwrap()]),
+        Linear(1e4),
+    )
+    .unwrap();
+    let mut system = System::new(model);
+    system.add_element(contact).unwrap();
+    let x0 = system.initial_state(0.0, &[0.05], &[0.0]).unwrap();
+    let opts = Options::with_tolerances(1e-10, 1e-12);
+    let sol = solve_with_events(
+        &mut MultibodyOde::new(&system),
+        Method::DormandPrince54,
+        0.0,
+        &x0,
+        0.12,
+        &opts,
+        &mut |_, _| EventAction::Record,
+    )
+    .unwrap();
+    assert!(sol.events.len() >= 2, "{:?}", sol.events);
+    assert_eq!(sol.events[0].name, "contact 'ball-floor' #0");
+    // Touch-down when the centre has fallen 4 cm: t = sqrt(2 · 0.04 / g).
+    let t_touch = (2.0 * 0.04 / 9.81f64).sqrt();
+    assert!(
+        (sol.events[0].time - t_touch).abs() < 1e-9,
+        "{} vs {t_touch}",
+        sol.events[0].time
+    );
+    // A linear spring contact lasts half a period π sqrt(m/k) (gravity shifts it slightly).
+    let duration = sol.events[1].time - sol.events[0].time;
+    let half_period = std::f64::consts::PI * (0.01f64 / 1e4).sqrt();
+    assert!(
+        (duration - half_period).abs() < 0.02 * half_period,
+        "{duration} vs {half_period}"
+    );
+}
