@@ -452,6 +452,109 @@ impl ForceElement for PivotFriction {
     }
 }
 
+/// A joint limit: a one-sided stiff spring–damper that acts only beyond `lower` or `upper`
+/// (a stop, a rail, the jack's window): `τ = k (lower − q) − c q̇` below the lower limit,
+/// `τ = −k (q − upper) − c q̇` above the upper one, zero in between (the damping never
+/// pulls the joint back into a stop). Its switching functions are `q − lower` and
+/// `upper − q`, so an integrator can locate the impacts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointLimit {
+    name: String,
+    joint: String,
+    coordinate: usize,
+    lower: f64,
+    upper: f64,
+    stiffness: f64,
+    damping: f64,
+}
+
+impl JointLimit {
+    /// A limit on the joint named `joint` (use `f64::NEG_INFINITY` / `f64::INFINITY` for a
+    /// side without a stop); stiffness and damping non-negative, `lower < upper`.
+    pub fn new(
+        model: &Model,
+        joint: &str,
+        lower: f64,
+        upper: f64,
+        stiffness: f64,
+        damping: f64,
+    ) -> Result<Self> {
+        let name = format!("joint limit '{joint}'");
+        if lower.is_nan() || upper.is_nan() || lower >= upper {
+            return Err(CoreError::InvalidParameter {
+                item: name,
+                message: format!("needs lower < upper, got {lower} and {upper}"),
+            });
+        }
+        Ok(Self {
+            coordinate: model.coordinate_id(joint)?,
+            stiffness: param(&name, "stiffness", stiffness, true)?,
+            damping: param(&name, "damping", damping, true)?,
+            lower,
+            upper,
+            joint: joint.to_string(),
+            name,
+        })
+    }
+
+    /// The generalized force at coordinate `q` and rate `v`.
+    pub fn torque(&self, q: f64, v: f64) -> f64 {
+        if q < self.lower {
+            (self.stiffness * (self.lower - q) - self.damping * v).max(0.0)
+        } else if q > self.upper {
+            (-self.stiffness * (q - self.upper) - self.damping * v).min(0.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+impl ForceElement for JointLimit {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn check_model(&self, model: &Model) -> Result<()> {
+        check_coordinate(model, &self.name, &self.joint, self.coordinate)
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
+        let k = self.coordinate;
+        loads.add_generalized(k, self.torque(ctx.q[k], ctx.v[k]));
+    }
+
+    fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
+        let q = ctx.q[self.coordinate];
+        let e = if q < self.lower {
+            self.lower - q
+        } else if q > self.upper {
+            q - self.upper
+        } else {
+            0.0
+        };
+        0.5 * self.stiffness * e * e
+    }
+
+    fn switch_count(&self) -> usize {
+        2
+    }
+
+    fn switching_functions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
+        let q = ctx.q[self.coordinate];
+        // Infinite limits never cross.
+        out[0] = if self.lower.is_finite() {
+            q - self.lower
+        } else {
+            1.0
+        };
+        out[1] = if self.upper.is_finite() {
+            self.upper - q
+        } else {
+            1.0
+        };
+    }
+}
+
 /// The frame in which an applied force's direction is fixed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LoadFrame {

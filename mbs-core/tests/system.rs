@@ -667,3 +667,26 @@ fn poses_and_accelerations_are_valid_after_the_dynamics_calls() {
     let a = mbs_core::point_acceleration(ws.data(), body, [0.0, 0.0]);
     assert!((a[1] + 9.81).abs() < 1e-12 && a[0].abs() < 1e-12, "{a:?}");
 }
+
+#[test]
+fn joint_limits_act_only_beyond_their_stops() {
+    let model = double_pendulum();
+    let lim = mbs_core::elements::JointLimit::new(&model, "lower", -0.2, 0.3, 100.0, 1.0).unwrap();
+    assert_eq!(lim.torque(0.0, 5.0), 0.0);
+    assert!((lim.torque(-0.25, 0.0) - 5.0).abs() < 1e-12);
+    assert!((lim.torque(0.35, 0.0) + 5.0).abs() < 1e-12);
+    // Damping resists entering the stop but never pulls the joint back into it.
+    assert!((lim.torque(-0.25, -1.0) - 6.0).abs() < 1e-12);
+    assert_eq!(lim.torque(-0.201, 10.0), 0.0);
+    assert!(mbs_core::elements::JointLimit::new(&model, "lower", 0.3, 0.3, 1.0, 0.0).is_err());
+    let mut system = System::new(model);
+    system.add_element(lim).unwrap();
+    let mut ws = system.workspace();
+    let mut g = [0.0; 2];
+    system
+        .switching_functions(&mut ws, 0.0, &[0.0, 0.1, 0.0, 0.0], &mut g)
+        .unwrap();
+    assert!((g[0] - 0.3).abs() < 1e-15 && (g[1] - 0.2).abs() < 1e-15);
+    let e = system.energy(&mut ws, 0.0, &[0.0, 0.4, 0.0, 0.0]).unwrap();
+    assert!((e.elastic - 0.5).abs() < 1e-12);
+}
