@@ -1,13 +1,18 @@
-//! # piano-action (stub)
+//! # piano-action: the grand piano action on the planar multibody framework
 //!
-//! **Not built yet.** This crate will hold the grand piano action plugin: parameters, the
-//! simplified, single- and double-escapement models, regulation, touches, events, metrics
-//! and the `piano` command.
-//!
-//! Until then it only re-exports its dependencies so the workspace layout is in place.
+//! **In progress.** Built so far: the parameter set (one documented TOML file, embedded as
+//! the default, loaded with errors that name the field) and the three progressive models
+//! (simplified, single escapement, double escapement) assembled from it as
+//! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts.
+//! Regulation, inputs and touches, events and metrics, and the `piano` command are still to
+//! come.
 
 #![warn(missing_docs)]
 
-pub use mbs_contact;
-pub use mbs_core;
-pub use mbs_integrators;
+mod action;
+mod error;
+pub mod params;
+
+pub use action::{Action, ModelKind};
+pub use error::{PianoError, Result};
+pub use params::ActionParams;

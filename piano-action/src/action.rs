@@ -1,0 +1,472 @@
+//! The three progressive grand actions assembled from one parameter set.
+//!
+//! Bodies and joints (all joint frames at the pivots, world-aligned at rest except the
+//! hammer's, which lies along the shank):
+//!
+//! - key: revolute at the balance pivot, positive when the front goes down;
+//! - wippen: revolute at its flange, negative when it rises;
+//! - jack: revolute on the wippen (fixed to it in the simplified model), positive when it
+//!   turns out from under the knuckle;
+//! - repetition lever (double escapement only): revolute on the wippen, positive when pushed
+//!   down;
+//! - hammer: revolute at its flange, positive when the head rises.
+//!
+//! Contacts (Hunt–Crossley felt laws with regularised Coulomb friction where μ > 0):
+//! key–front rail, key–back rail, capstan–heel, jack–knuckle, lever–knuckle, jack
+//! toe–let-off button, lever tip–drop screw, tail–backcheck, shank–rest rail,
+//! hammer–string. Springs: repetition and jack springs, with their stops as joint limits.
+//! Pivot friction at every centre.
+
+use std::collections::BTreeMap;
+
+use mbs_contact::laws::{HuntCrossley, RegularizedCoulomb};
+use mbs_contact::{Contact, ContactSide, Shape};
+use mbs_core::elements::{FrictionLaw, JointLimit, JointSpringDamper, PivotFriction, SpringLaw};
+use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System};
+
+use crate::error::Result;
+use crate::params::{ActionParams, ContactParams};
+
+/// Which of the three progressive models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ModelKind {
+    /// Key, wippen with the jack fixed to it, hammer: no escapement, no repetition lever.
+    Simplified,
+    /// Adds the jack with its spring and the let-off button, and the backcheck.
+    Single,
+    /// Adds the repetition lever, its spring and the drop screw.
+    Double,
+}
+
+impl ModelKind {
+    /// All three, simplest first.
+    pub const ALL: [ModelKind; 3] = [ModelKind::Simplified, ModelKind::Single, ModelKind::Double];
+
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Simplified => "simplified",
+            ModelKind::Single => "single",
+            ModelKind::Double => "double",
+        }
+    }
+}
+
+/// An assembled action: the system to integrate, and where things are in it.
+pub struct Action {
+    /// Which model.
+    pub kind: ModelKind,
+    /// The parameters it was built from.
+    pub params: ActionParams,
+    /// The multibody system (model, force elements).
+    pub system: System,
+    /// Element index of each contact, by name (`"capstan_heel"`, `"hammer_string"`, ...).
+    pub contacts: BTreeMap<&'static str, usize>,
+}
+
+/// mm → m.
+fn m(v: [f64; 2]) -> [f64; 2] {
+    [v[0] * 1e-3, v[1] * 1e-3]
+}
+
+fn rel(p: [f64; 2], origin: [f64; 2]) -> [f64; 2] {
+    m([p[0] - origin[0], p[1] - origin[1]])
+}
+
+/// A horizontal ground face at height `y` over `x`, facing up or down (mm in, shape in m).
+fn ground_face(y: f64, x: [f64; 2], up: bool) -> Result<Shape> {
+    let (a, b) = if up {
+        ([x[0], y], [x[1], y])
+    } else {
+        ([x[1], y], [x[0], y])
+    };
+    Ok(Shape::segment(m(a), m(b))?)
+}
+
+/// A face through `p` along direction `d` (unit), from `back` before to `ahead` after `p`,
+/// its outward normal `d` turned a quarter counter-clockwise (mm in, shape in m).
+fn face(p: [f64; 2], d: [f64; 2], back: f64, ahead: f64) -> Result<Shape> {
+    let a = [p[0] - back * d[0], p[1] - back * d[1]];
+    let b = [p[0] + ahead * d[0], p[1] + ahead * d[1]];
+    Ok(Shape::segment(m(a), m(b))?)
+}
+
+fn circle(c: [f64; 2], r_mm: f64) -> Result<Shape> {
+    Ok(Shape::circle(m(c), r_mm * 1e-3)?)
+}
+
+impl Action {
+    /// Assembles `kind` from `params`.
+    pub fn build(params: &ActionParams, kind: ModelKind) -> Result<Action> {
+        params.validate()?;
+        let p = params;
+        let (k, w, j, r, h) = (&p.key, &p.wippen, &p.jack, &p.repetition_lever, &p.hammer);
+        let with_jack = kind != ModelKind::Simplified;
+        let with_lever = kind == ModelKind::Double;
+
+        // Bodies: mass (kg), centre of mass in the joint frame (m), inertia about it.
+        let mut b = ModelBuilder::new();
+        b.gravity([0.0, -9.81]);
+        let key_com = rel(k.com_mm, k.pivot_mm);
+        let key_mass = k.mass_g * 1e-3;
+        let key_i = k.inertia_pivot_kg_m2 - key_mass * (key_com[0].powi(2) + key_com[1].powi(2));
+        b.add_link(
+            "key",
+            None,
+            JointKind::Revolute,
+            Placement::offset(k.pivot_mm[0] * 1e-3, k.pivot_mm[1] * 1e-3),
+            BodySpec::new(key_mass, key_com, key_i),
+        );
+        b.add_link(
+            "wippen",
+            None,
+            JointKind::Revolute,
+            Placement::offset(w.pivot_mm[0] * 1e-3, w.pivot_mm[1] * 1e-3),
+            BodySpec::new(
+                w.mass_g * 1e-3,
+                rel(w.com_mm, w.pivot_mm),
+                w.inertia_com_kg_m2,
+            ),
+        );
+        let jack_at = rel(j.pivot_mm, w.pivot_mm);
+        let jack_com = rel(j.com_mm, j.pivot_mm);
+        let jack_mass = j.mass_g * 1e-3;
+        let jack_i =
+            j.inertia_pivot_kg_m2 - jack_mass * (jack_com[0].powi(2) + jack_com[1].powi(2));
+        b.add_link(
+            "jack",
+            Some("wippen"),
+            if with_jack {
+                JointKind::Revolute
+            } else {
+                JointKind::Fixed
+            },
+            Placement::offset(jack_at[0], jack_at[1]),
+            BodySpec::new(jack_mass, jack_com, jack_i),
+        );
+        if with_lever {
+            let at = rel(r.pivot_mm, w.pivot_mm);
+            let com = rel(r.com_mm, r.pivot_mm);
+            let mass = r.mass_g * 1e-3;
+            let i = r.inertia_pivot_kg_m2 - mass * (com[0].powi(2) + com[1].powi(2));
+            b.add_link(
+                "repetition_lever",
+                Some("wippen"),
+                JointKind::Revolute,
+                Placement::offset(at[0], at[1]),
+                BodySpec::new(mass, com, i),
+            );
+        }
+        b.add_link(
+            "hammer",
+            None,
+            JointKind::Revolute,
+            Placement::new(
+                h.rest_angle_deg.to_radians(),
+                h.pivot_mm[0] * 1e-3,
+                h.pivot_mm[1] * 1e-3,
+            ),
+            BodySpec::new(h.mass_g * 1e-3, m(h.com_body_mm), h.inertia_com_kg_m2),
+        );
+        let model = b.build()?;
+        let mut system = System::new(model.clone());
+
+        // Springs, stops and pivot friction.
+        let reg = p.numerics.pivot_friction_regularization_rad_s;
+        let mut pivots = vec![
+            ("key", k.pivot_friction_n_m),
+            ("wippen", w.pivot_friction_n_m),
+            ("hammer", h.pivot_friction_n_m),
+        ];
+        let (stop_k, stop_c) = (
+            p.numerics.stop_stiffness_n_m_per_rad,
+            p.numerics.stop_damping_n_m_s_per_rad,
+        );
+        if with_jack {
+            pivots.push(("jack", j.pivot_friction_n_m));
+            let law = SpringLaw::new(j.spring_stiffness_n_m_per_rad, 0.0)
+                .with_preload(-j.spring_preload_n_m);
+            system
+                .add_element(JointSpringDamper::new(&model, "jack", law)?.named("jack spring"))?;
+            system.add_element(JointLimit::new(
+                &model,
+                "jack",
+                j.stop_angle_rad,
+                f64::INFINITY,
+                stop_k,
+                stop_c,
+            )?)?;
+        }
+        if with_lever {
+            pivots.push(("repetition_lever", r.pivot_friction_n_m));
+            let law = SpringLaw::new(r.spring_stiffness_n_m_per_rad, 0.0)
+                .with_preload(-r.spring_preload_n_m);
+            system.add_element(
+                JointSpringDamper::new(&model, "repetition_lever", law)?.named("repetition spring"),
+            )?;
+            system.add_element(JointLimit::new(
+                &model,
+                "repetition_lever",
+                r.upper_stop_rad,
+                f64::INFINITY,
+                stop_k,
+                stop_c,
+            )?)?;
+        }
+        for (joint, torque) in pivots {
+            if torque > 0.0 {
+                system.add_element(PivotFriction::new(
+                    &model,
+                    joint,
+                    FrictionLaw::coulomb(torque, reg),
+                )?)?;
+            }
+        }
+
+        // Contact shapes, each in its body's joint frame.
+        let g = &p.regulation;
+        let kp = k.pivot_mm;
+        let capstan = [
+            k.capstan_center_mm[0],
+            k.capstan_center_mm[1] + g.capstan_raise_mm,
+        ];
+        let heel = face(
+            [w.heel_mm[0] - w.pivot_mm[0], w.heel_mm[1] - w.pivot_mm[1]],
+            [-1.0, 0.0],
+            w.heel_half_length_mm,
+            w.heel_half_length_mm,
+        )?;
+        // Jack top: along t, facing the jack axis n.
+        let n = j.axis;
+        let t = [n[1], -n[0]];
+        let jack_top = face(
+            [j.top_mm[0] - j.pivot_mm[0], j.top_mm[1] - j.pivot_mm[1]],
+            t,
+            j.top_front_edge_mm,
+            j.top_back_edge_mm,
+        )?;
+        let toe = circle(
+            [
+                j.toe_mm[0] - j.pivot_mm[0],
+                j.toe_mm[1] - j.pivot_mm[1] - j.toe_radius_mm,
+            ],
+            j.toe_radius_mm,
+        )?;
+        // Backcheck face on the key, at its angle, facing the hammer tail at rest.
+        let a = k.backcheck_face_angle_deg.to_radians();
+        let d = [a.cos(), a.sin()];
+        let tail_rest = {
+            let (s, c) = h.rest_angle_deg.to_radians().sin_cos();
+            let tb = h.tail_body_mm;
+            [
+                h.pivot_mm[0] + c * tb[0] - s * tb[1],
+                h.pivot_mm[1] + s * tb[0] + c * tb[1],
+            ]
+        };
+        let to_tail = [
+            tail_rest[0] - k.backcheck_mm[0],
+            tail_rest[1] - k.backcheck_mm[1],
+        ];
+        let d = if -d[1] * to_tail[0] + d[0] * to_tail[1] >= 0.0 {
+            d
+        } else {
+            [-d[0], -d[1]]
+        };
+        let backcheck = face(
+            [k.backcheck_mm[0] - kp[0], k.backcheck_mm[1] - kp[1]],
+            d,
+            k.backcheck_half_length_mm,
+            k.backcheck_half_length_mm,
+        )?;
+        let knuckle = circle(h.knuckle_body_mm, h.knuckle_radius_mm)?;
+        let crown = circle(
+            [h.strike_body_mm[0], h.strike_body_mm[1] - h.crown_radius_mm],
+            h.crown_radius_mm,
+        )?;
+        let tail = circle(h.tail_body_mm, h.tail_radius_mm)?;
+        let shank_under = circle([h.rest_body_mm[0], h.rest_body_mm[1] + 0.5], 0.5)?;
+
+        let mut contacts = BTreeMap::new();
+        let mut add = |name: &'static str,
+                       a: ContactSide,
+                       b: ContactSide,
+                       law: &ContactParams,
+                       system: &mut System|
+         -> Result<()> {
+            let normal = HuntCrossley::from_restitution(
+                law.k,
+                law.p,
+                law.e,
+                p.numerics.contact_reference_speed_m_s,
+            )?;
+            let mut c = Contact::new(&model, name, a, b, normal)?;
+            if law.mu > 0.0 {
+                c = c.with_friction(RegularizedCoulomb::new(
+                    law.mu,
+                    p.numerics.friction_regularization_m_s,
+                )?);
+            }
+            contacts.insert(name, system.add_element(c)?);
+            Ok(())
+        };
+        let c = &p.contacts;
+        add(
+            "front_rail",
+            ContactSide::ground(vec![ground_face(
+                g.front_rail_top_y_mm,
+                g.front_rail_x_mm,
+                true,
+            )?]),
+            ContactSide::on(
+                "key",
+                vec![circle(
+                    [k.front_pad_mm[0] - kp[0], k.front_pad_mm[1] - kp[1]],
+                    k.front_pad_radius_mm,
+                )?],
+            ),
+            &c.front_rail,
+            &mut system,
+        )?;
+        add(
+            "back_rail",
+            ContactSide::ground(vec![ground_face(
+                g.back_rail_top_y_mm,
+                g.back_rail_x_mm,
+                true,
+            )?]),
+            ContactSide::on(
+                "key",
+                vec![circle(
+                    [k.back_pad_mm[0] - kp[0], k.back_pad_mm[1] - kp[1]],
+                    k.back_pad_radius_mm,
+                )?],
+            ),
+            &c.back_rail,
+            &mut system,
+        )?;
+        add(
+            "capstan_heel",
+            ContactSide::on(
+                "key",
+                vec![circle(
+                    [capstan[0] - kp[0], capstan[1] - kp[1]],
+                    k.capstan_radius_mm,
+                )?],
+            ),
+            ContactSide::on("wippen", vec![heel]),
+            &c.capstan_heel,
+            &mut system,
+        )?;
+        add(
+            "jack_knuckle",
+            ContactSide::on("jack", vec![jack_top]),
+            ContactSide::on("hammer", vec![knuckle]),
+            &c.jack_knuckle,
+            &mut system,
+        )?;
+        if with_jack {
+            add(
+                "let_off_button",
+                ContactSide::ground(vec![ground_face(
+                    g.let_off_button_y_mm,
+                    g.let_off_button_x_mm,
+                    false,
+                )?]),
+                ContactSide::on("jack", vec![toe]),
+                &c.let_off_button,
+                &mut system,
+            )?;
+            add(
+                "backcheck",
+                ContactSide::on("key", vec![backcheck]),
+                ContactSide::on("hammer", vec![tail]),
+                &c.backcheck,
+                &mut system,
+            )?;
+        }
+        if with_lever {
+            let lever_top = face(
+                [r.top_mm[0] - r.pivot_mm[0], r.top_mm[1] - r.pivot_mm[1]],
+                t,
+                r.top_front_edge_mm,
+                r.top_back_edge_mm,
+            )?;
+            let tip = circle(
+                [
+                    r.tip_mm[0] - r.pivot_mm[0],
+                    r.tip_mm[1] - r.pivot_mm[1] - r.tip_radius_mm,
+                ],
+                r.tip_radius_mm,
+            )?;
+            add(
+                "lever_knuckle",
+                ContactSide::on("repetition_lever", vec![lever_top]),
+                ContactSide::on("hammer", vec![knuckle]),
+                &c.lever_knuckle,
+                &mut system,
+            )?;
+            add(
+                "drop_screw",
+                ContactSide::ground(vec![ground_face(
+                    g.drop_screw_y_mm,
+                    g.drop_screw_x_mm,
+                    false,
+                )?]),
+                ContactSide::on("repetition_lever", vec![tip]),
+                &c.drop_screw,
+                &mut system,
+            )?;
+        }
+        add(
+            "rest_rail",
+            ContactSide::ground(vec![ground_face(
+                g.rest_rail_top_y_mm,
+                g.rest_rail_x_mm,
+                true,
+            )?]),
+            ContactSide::on("hammer", vec![shank_under]),
+            &c.rest_rail,
+            &mut system,
+        )?;
+        add(
+            "hammer_string",
+            ContactSide::ground(vec![ground_face(g.string_y_mm, g.string_x_mm, false)?]),
+            ContactSide::on("hammer", vec![crown]),
+            &c.hammer_string,
+            &mut system,
+        )?;
+        Ok(Action {
+            kind,
+            params: params.clone(),
+            system,
+            contacts,
+        })
+    }
+
+    /// The state at rest as laid out: every coordinate zero, at rest, internal states at
+    /// their initial values.
+    pub fn layout_state(&self) -> Result<Vec<f64>> {
+        let n = self.system.model().nv();
+        Ok(self
+            .system
+            .initial_state(0.0, &vec![0.0; n], &vec![0.0; n])?)
+    }
+
+    /// The gap (m) of the named contact at state `x`.
+    pub fn gap(&self, name: &str, x: &[f64]) -> Result<f64> {
+        let e = *self
+            .contacts
+            .get(name)
+            .ok_or_else(|| mbs_core::CoreError::UnknownName {
+                what: "contact",
+                name: name.to_string(),
+            })?;
+        let mut ws = self.system.workspace();
+        let ctx = self.system.element_context(&mut ws, 0.0, x, e)?;
+        let mut g = [0.0];
+        if let Some(el) = self.system.elements().nth(e) {
+            el.switching_functions(&ctx, &mut g);
+        }
+        Ok(g[0])
+    }
+}

@@ -1,0 +1,383 @@
+//! The action's parameters: one documented TOML file, embedded as the default.
+//!
+//! Every field is named after what it is and carries its unit; see
+//! `src/default_params.toml` for the values, their tags and sources.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PianoError, Result};
+
+/// The default parameter file (the reference grand action), as text.
+pub const DEFAULT_PARAMS_TOML: &str = include_str!("default_params.toml");
+
+/// The key: a lever on the balance rail.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyParams {
+    /// Balance pivot (mm).
+    pub pivot_mm: [f64; 2],
+    /// Key front top, where the finger presses (mm).
+    pub finger_mm: [f64; 2],
+    /// Mass (g).
+    pub mass_g: f64,
+    /// Centre of mass (mm).
+    pub com_mm: [f64; 2],
+    /// Rotational inertia about the balance pivot (kg·m²).
+    pub inertia_pivot_kg_m2: f64,
+    /// Capstan head centre (mm).
+    pub capstan_center_mm: [f64; 2],
+    /// Capstan head radius (mm).
+    pub capstan_radius_mm: f64,
+    /// Rounded key underside over the front-rail punching: centre (mm).
+    pub front_pad_mm: [f64; 2],
+    /// Its radius (mm).
+    pub front_pad_radius_mm: f64,
+    /// Rounded key underside over the back-rail cloth: centre (mm).
+    pub back_pad_mm: [f64; 2],
+    /// Its radius (mm).
+    pub back_pad_radius_mm: f64,
+    /// Backcheck catch point (mm).
+    pub backcheck_mm: [f64; 2],
+    /// Backcheck face angle to the key (deg).
+    pub backcheck_face_angle_deg: f64,
+    /// Half length of the backcheck face (mm).
+    pub backcheck_half_length_mm: f64,
+    /// Coulomb friction of the key bushings about the balance pin (N·m).
+    pub pivot_friction_n_m: f64,
+}
+
+/// The wippen, pinned at the rear on its flange.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WippenParams {
+    /// Flange centre pin (mm).
+    pub pivot_mm: [f64; 2],
+    /// Mass (g).
+    pub mass_g: f64,
+    /// Centre of mass (mm).
+    pub com_mm: [f64; 2],
+    /// Rotational inertia about the centre of mass (kg·m²).
+    pub inertia_com_kg_m2: f64,
+    /// Heel contact point on the capstan (mm).
+    pub heel_mm: [f64; 2],
+    /// Half length of the flat heel (mm).
+    pub heel_half_length_mm: f64,
+    /// Coulomb friction at the flange (N·m).
+    pub pivot_friction_n_m: f64,
+}
+
+/// The jack, pinned on the wippen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JackParams {
+    /// Centre pin on the wippen (mm).
+    pub pivot_mm: [f64; 2],
+    /// Mass (g).
+    pub mass_g: f64,
+    /// Centre of mass (mm).
+    pub com_mm: [f64; 2],
+    /// Rotational inertia about its pin (kg·m²).
+    pub inertia_pivot_kg_m2: f64,
+    /// Top contact with the knuckle at rest (mm).
+    pub top_mm: [f64; 2],
+    /// Jack axis (unit vector, pin toward top).
+    pub axis: [f64; 2],
+    /// Length of the top behind the contact, toward the strings (mm): sets the escape.
+    pub top_back_edge_mm: f64,
+    /// Length of the top in front of the contact (mm).
+    pub top_front_edge_mm: f64,
+    /// Toe contact with the let-off button (mm).
+    pub toe_mm: [f64; 2],
+    /// Toe rounding radius (mm).
+    pub toe_radius_mm: f64,
+    /// Jack spring torque at rest (N·m), turning the jack back under the knuckle.
+    pub spring_preload_n_m: f64,
+    /// Jack spring stiffness (N·m/rad).
+    pub spring_stiffness_n_m_per_rad: f64,
+    /// Jack stop: the jack cannot turn back past this angle from rest (rad).
+    pub stop_angle_rad: f64,
+    /// Coulomb friction at the jack centre (N·m).
+    pub pivot_friction_n_m: f64,
+}
+
+/// The repetition lever, pinned on the wippen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RepetitionLeverParams {
+    /// Centre pin on the wippen (mm).
+    pub pivot_mm: [f64; 2],
+    /// Mass (g).
+    pub mass_g: f64,
+    /// Centre of mass (mm).
+    pub com_mm: [f64; 2],
+    /// Rotational inertia about its pin (kg·m²).
+    pub inertia_pivot_kg_m2: f64,
+    /// A point of its top surface under the knuckle (mm); the surface is parallel to the
+    /// jack top.
+    pub top_mm: [f64; 2],
+    /// Length of the top behind that point (mm).
+    pub top_back_edge_mm: f64,
+    /// Length of the top in front of that point (mm).
+    pub top_front_edge_mm: f64,
+    /// Front tip under the drop screw (mm).
+    pub tip_mm: [f64; 2],
+    /// Tip rounding radius (mm).
+    pub tip_radius_mm: f64,
+    /// Repetition spring torque at rest (N·m), lifting the lever.
+    pub spring_preload_n_m: f64,
+    /// Repetition spring stiffness (N·m/rad).
+    pub spring_stiffness_n_m_per_rad: f64,
+    /// Upper stop angle from rest (rad, negative: lever up).
+    pub upper_stop_rad: f64,
+    /// Coulomb friction at the lever centre (N·m).
+    pub pivot_friction_n_m: f64,
+}
+
+/// The hammer on its flange. Body points (`*_body_mm`) are in the shank frame: origin at
+/// the centre pin, x along the shank toward the head.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HammerParams {
+    /// Flange centre pin (mm).
+    pub pivot_mm: [f64; 2],
+    /// Shank angle at rest (deg).
+    pub rest_angle_deg: f64,
+    /// Mass of hammer and shank (g).
+    pub mass_g: f64,
+    /// Centre of mass (body, mm).
+    pub com_body_mm: [f64; 2],
+    /// Rotational inertia about the centre of mass (kg·m²).
+    pub inertia_com_kg_m2: f64,
+    /// Knuckle centre (body, mm).
+    pub knuckle_body_mm: [f64; 2],
+    /// Knuckle radius (mm).
+    pub knuckle_radius_mm: f64,
+    /// Strike point on the crown (body, mm).
+    pub strike_body_mm: [f64; 2],
+    /// Crown radius of curvature (mm).
+    pub crown_radius_mm: f64,
+    /// Tail catch point (body, mm).
+    pub tail_body_mm: [f64; 2],
+    /// Tail rounding radius (mm).
+    pub tail_radius_mm: f64,
+    /// Shank underside over the rest rail (body, mm).
+    pub rest_body_mm: [f64; 2],
+    /// Coulomb friction at the flange (N·m).
+    pub pivot_friction_n_m: f64,
+}
+
+/// Positions of the regulating screws, rails and the string.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegulationParams {
+    /// Let-off button lower face height (mm).
+    pub let_off_button_y_mm: f64,
+    /// Its extent along x (mm).
+    pub let_off_button_x_mm: [f64; 2],
+    /// Drop screw tip height (mm).
+    pub drop_screw_y_mm: f64,
+    /// Its extent along x (mm).
+    pub drop_screw_x_mm: [f64; 2],
+    /// String height (mm).
+    pub string_y_mm: f64,
+    /// Its extent along x (mm).
+    pub string_x_mm: [f64; 2],
+    /// Rest-rail cushion top (mm).
+    pub rest_rail_top_y_mm: f64,
+    /// Its extent along x (mm).
+    pub rest_rail_x_mm: [f64; 2],
+    /// Front-rail punching top (mm).
+    pub front_rail_top_y_mm: f64,
+    /// Its extent along x (mm).
+    pub front_rail_x_mm: [f64; 2],
+    /// Back-rail cloth top (mm).
+    pub back_rail_top_y_mm: f64,
+    /// Its extent along x (mm).
+    pub back_rail_x_mm: [f64; 2],
+    /// Capstan turned up (+) or down from the layout (mm).
+    pub capstan_raise_mm: f64,
+}
+
+/// A felt, cloth or leather contact: Hunt–Crossley `F = k δ^p (1 + 1.5 (1 − e) δ̇ / v_ref)`
+/// and regularised Coulomb friction `μ`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactParams {
+    /// Stiffness (N/m^p).
+    pub k: f64,
+    /// Exponent.
+    pub p: f64,
+    /// Restitution at the reference speed.
+    pub e: f64,
+    /// Friction coefficient (0 for none).
+    pub mu: f64,
+}
+
+/// All contact laws of the action.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactsParams {
+    /// Key on the front-rail punching.
+    pub front_rail: ContactParams,
+    /// Key tail on the back-rail cloth.
+    pub back_rail: ContactParams,
+    /// Capstan on the wippen heel.
+    pub capstan_heel: ContactParams,
+    /// Jack top on the knuckle.
+    pub jack_knuckle: ContactParams,
+    /// Repetition lever on the knuckle.
+    pub lever_knuckle: ContactParams,
+    /// Jack toe on the let-off button.
+    pub let_off_button: ContactParams,
+    /// Repetition lever tip on the drop screw.
+    pub drop_screw: ContactParams,
+    /// Hammer tail on the backcheck.
+    pub backcheck: ContactParams,
+    /// Shank on the rest-rail cushion.
+    pub rest_rail: ContactParams,
+    /// Hammer felt on the string.
+    pub hammer_string: ContactParams,
+}
+
+/// Numerical settings of the model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NumericsParams {
+    /// Reference speed of the Hunt–Crossley damping (m/s).
+    pub contact_reference_speed_m_s: f64,
+    /// Velocity scale of contact friction (m/s).
+    pub friction_regularization_m_s: f64,
+    /// Angular velocity scale of pivot friction (rad/s).
+    pub pivot_friction_regularization_rad_s: f64,
+    /// Stiffness of the jack and repetition-lever stops (N·m/rad).
+    pub stop_stiffness_n_m_per_rad: f64,
+    /// Damping of those stops (N·m·s/rad).
+    pub stop_damping_n_m_s_per_rad: f64,
+}
+
+/// The whole parameter set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActionParams {
+    /// The key.
+    pub key: KeyParams,
+    /// The wippen.
+    pub wippen: WippenParams,
+    /// The jack.
+    pub jack: JackParams,
+    /// The repetition lever.
+    pub repetition_lever: RepetitionLeverParams,
+    /// The hammer.
+    pub hammer: HammerParams,
+    /// Screws, rails and string.
+    pub regulation: RegulationParams,
+    /// Contact laws.
+    pub contacts: ContactsParams,
+    /// Numerical settings.
+    pub numerics: NumericsParams,
+}
+
+impl ActionParams {
+    /// The reference grand action (the embedded default file).
+    pub fn reference() -> Self {
+        // The embedded file is tested to parse; a failure here is a build defect.
+        Self::from_toml_str(DEFAULT_PARAMS_TOML)
+            .unwrap_or_else(|e| unreachable!("the embedded parameter file is invalid: {e}"))
+    }
+
+    /// Parses a parameter file; an error names the field (as a path such as
+    /// `hammer.mass_g`) and where it is.
+    pub fn from_toml_str(text: &str) -> Result<Self> {
+        let de = toml::Deserializer::parse(text).map_err(|e| PianoError::Params {
+            field: String::new(),
+            message: e.to_string(),
+        })?;
+        let params: ActionParams =
+            serde_path_to_error::deserialize(de).map_err(|e| PianoError::Params {
+                field: e.path().to_string(),
+                message: e.inner().to_string(),
+            })?;
+        params.validate()?;
+        Ok(params)
+    }
+
+    /// Checks every number is finite and every mass, inertia, radius and stiffness is
+    /// positive, naming the first bad field.
+    pub fn validate(&self) -> Result<()> {
+        let table = toml::Table::try_from(self).map_err(|e| PianoError::Params {
+            field: String::new(),
+            message: e.to_string(),
+        })?;
+        check_table("", &table)?;
+        let positive = [
+            ("key.mass_g", self.key.mass_g),
+            ("key.inertia_pivot_kg_m2", self.key.inertia_pivot_kg_m2),
+            ("key.capstan_radius_mm", self.key.capstan_radius_mm),
+            ("wippen.mass_g", self.wippen.mass_g),
+            ("wippen.inertia_com_kg_m2", self.wippen.inertia_com_kg_m2),
+            ("jack.mass_g", self.jack.mass_g),
+            ("jack.inertia_pivot_kg_m2", self.jack.inertia_pivot_kg_m2),
+            ("repetition_lever.mass_g", self.repetition_lever.mass_g),
+            (
+                "repetition_lever.inertia_pivot_kg_m2",
+                self.repetition_lever.inertia_pivot_kg_m2,
+            ),
+            ("hammer.mass_g", self.hammer.mass_g),
+            ("hammer.inertia_com_kg_m2", self.hammer.inertia_com_kg_m2),
+            ("hammer.knuckle_radius_mm", self.hammer.knuckle_radius_mm),
+            ("hammer.crown_radius_mm", self.hammer.crown_radius_mm),
+            (
+                "numerics.contact_reference_speed_m_s",
+                self.numerics.contact_reference_speed_m_s,
+            ),
+        ];
+        for (field, v) in positive {
+            if v <= 0.0 {
+                return Err(PianoError::Params {
+                    field: field.into(),
+                    message: format!("must be positive, got {v}"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The parameters as TOML text (for `piano params`; the embedded default keeps its
+    /// comments, this form does not).
+    pub fn to_toml_string(&self) -> Result<String> {
+        toml::to_string_pretty(self).map_err(|e| PianoError::Params {
+            field: String::new(),
+            message: e.to_string(),
+        })
+    }
+}
+
+/// Every number in the table must be finite.
+fn check_table(prefix: &str, table: &toml::Table) -> Result<()> {
+    for (k, v) in table {
+        let path = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        check_value(&path, v)?;
+    }
+    Ok(())
+}
+
+fn check_value(path: &str, v: &toml::Value) -> Result<()> {
+    match v {
+        toml::Value::Float(x) if !x.is_finite() => Err(PianoError::Params {
+            field: path.into(),
+            message: format!("must be finite, got {x}"),
+        }),
+        toml::Value::Table(t) => check_table(path, t),
+        toml::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                check_value(&format!("{path}[{i}]"), x)?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
