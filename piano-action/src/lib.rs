@@ -1,18 +1,22 @@
 //! # piano-action: the grand piano action on the planar multibody framework
 //!
 //! **In progress.** Built so far: the parameter set (one documented TOML file, embedded as
-//! the default, loaded with errors that name the field) and the three progressive models
+//! the default, loaded with errors that name the field); the three progressive models
 //! (simplified, single escapement, double escapement) assembled from it as
-//! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts.
-//! Regulation, inputs and touches, events and metrics, and the `piano` command are still to
-//! come.
+//! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts; and a
+//! keystroke driven by a force on the key front, integrated with TR-BDF2, with the piano
+//! events (let-off, string contact, key bottom, check, drop) and the strikes read off the
+//! contact events. Regulation, the other touches, run directories and the full `piano`
+//! command are still to come.
 
 #![warn(missing_docs)]
 
 mod action;
 mod error;
 pub mod params;
+pub mod simulate;
 
 pub use action::{Action, ModelKind};
 pub use error::{PianoError, Result};
 pub use params::ActionParams;
+pub use simulate::{Input, PianoEvent, Run, Strike, simulate};

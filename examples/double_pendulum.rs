@@ -1,4 +1,4 @@
-//! The default demo (`cargo run --release`), until the piano action exists: a double
+//! `cargo run --release --example double_pendulum`: a double
 //! pendulum built from an embedded JSON model, integrated with Dormand–Prince 5(4) from
 //! `mbs-integrators`, once conservative and once with pivot friction, printing the motion
 //! and the energy budget so the physics can be checked by eye.

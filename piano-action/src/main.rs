@@ -1,0 +1,102 @@
+//! The `piano` command. With no arguments it runs the demo: the double-escapement action
+//! pressed with forces from soft to loud, with a summary table.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use piano_action::{ActionParams, Input, ModelKind, simulate};
+
+/// Grand piano action simulator.
+#[derive(Parser)]
+#[command(
+    name = "piano",
+    version,
+    about = "Grand piano action simulator (planar multibody)"
+)]
+struct Cli {
+    /// Parameter file (TOML); the embedded reference action when absent.
+    #[arg(long, global = true)]
+    params: Option<std::path::PathBuf>,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Press the double-escapement action with forces from soft to loud and print a summary
+    /// (the default).
+    Demo,
+    /// Write the default parameter file (with its comments and sources) to standard output.
+    Params,
+}
+
+fn load(path: Option<&std::path::Path>) -> Result<ActionParams, String> {
+    match path {
+        None => Ok(ActionParams::reference()),
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+            ActionParams::from_toml_str(&text).map_err(|e| format!("{}: {e}", p.display()))
+        }
+    }
+}
+
+fn ms(t: Option<f64>) -> String {
+    t.map_or("-".into(), |t| format!("{:.1}", t * 1e3))
+}
+
+fn demo(params: &ActionParams) -> Result<(), String> {
+    println!("Double-escapement grand action, constant force on the key front from t = 0.");
+    println!("Times in ms; hammer velocity of the strike point at string contact.\n");
+    println!(
+        "{:>9} {:>9} {:>9} {:>9} {:>12} {:>10} {:>9}",
+        "force (N)", "let-off", "key bot.", "strike", "v_ham (m/s)", "contact", "check"
+    );
+    for force_n in [2.0, 4.0, 8.0, 16.0, 32.0] {
+        let run = simulate(
+            params,
+            ModelKind::Double,
+            &Input::Force {
+                force_n,
+                release_s: None,
+            },
+            0.25,
+            1e-3,
+        )
+        .map_err(|e| e.to_string())?;
+        let strike = run.strikes.first();
+        println!(
+            "{:>9.1} {:>9} {:>9} {:>9} {:>12} {:>10} {:>9}",
+            force_n,
+            ms(run.let_off_time_s),
+            ms(run.key_bottom_time_s),
+            ms(strike.map(|s| s.time_s)),
+            strike.map_or("-".into(), |s| format!("{:.2}", s.hammer_velocity_m_s)),
+            ms(strike.and_then(|s| s.contact_duration_s)),
+            ms(run.check_time_s),
+        );
+    }
+    println!("\n`piano params` writes the parameter file; `--params FILE` loads your own.");
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result =
+        load(cli.params.as_deref()).and_then(|params| match cli.command.unwrap_or(Command::Demo) {
+            Command::Demo => demo(&params),
+            Command::Params => {
+                use std::io::Write;
+                let _ = std::io::stdout()
+                    .write_all(piano_action::params::DEFAULT_PARAMS_TOML.as_bytes());
+                Ok(())
+            }
+        });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
