@@ -272,8 +272,13 @@ impl Action {
         } else {
             [-d[0], -d[1]]
         };
+        // Outward normal of the face (toward the tail); the regulation offset moves it.
+        let off = g.backcheck_offset_mm;
         let backcheck = face(
-            [k.backcheck_mm[0] - kp[0], k.backcheck_mm[1] - kp[1]],
+            [
+                k.backcheck_mm[0] - kp[0] - off * d[1],
+                k.backcheck_mm[1] - kp[1] + off * d[0],
+            ],
             d,
             k.backcheck_half_length_mm,
             k.backcheck_half_length_mm,

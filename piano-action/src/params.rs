@@ -196,6 +196,8 @@ pub struct RegulationParams {
     pub back_rail_x_mm: [f64; 2],
     /// Capstan turned up (+) or down from the layout (mm).
     pub capstan_raise_mm: f64,
+    /// Backcheck moved along its face normal, toward (+) or away from the hammer tail (mm).
+    pub backcheck_offset_mm: f64,
 }
 
 /// A felt, cloth or leather contact: Hunt–Crossley `F = k δ^p (1 + 1.5 (1 − e) δ̇ / v_ref)`
