@@ -21,8 +21,10 @@ use std::collections::BTreeMap;
 
 use mbs_contact::laws::{HuntCrossley, RegularizedCoulomb};
 use mbs_contact::{Contact, ContactSide, Shape};
+use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::elements::{FrictionLaw, JointLimit, JointSpringDamper, PivotFriction, SpringLaw};
-use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System};
+use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System, TimeFunction};
+use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_with_events};
 
 use crate::error::Result;
 use crate::params::{ActionParams, ContactParams};
@@ -446,6 +448,54 @@ impl Action {
             system,
             contacts,
         })
+    }
+
+    /// Adds a vertical force pressing down on the key front (the finger point), its
+    /// magnitude (N) a function of time.
+    pub fn add_key_force(&mut self, magnitude: impl TimeFunction + 'static) -> Result<()> {
+        let k = &self.params.key;
+        let at = [
+            (k.finger_mm[0] - k.pivot_mm[0]) * 1e-3,
+            (k.finger_mm[1] - k.pivot_mm[1]) * 1e-3,
+        ];
+        let model = self.system.model().clone();
+        let finger = AppliedLoad::force(
+            &model,
+            "finger",
+            Attachment::on("key", at),
+            [0.0, -1.0],
+            LoadFrame::World,
+            magnitude,
+        )?;
+        self.system.add_element(finger)?;
+        Ok(())
+    }
+
+    /// Integrates from `x0` to `t_end` with TR-BDF2 (rtol 1e-6, atol 1e-9), steps of at
+    /// most `max_step`, output every `output_step` (or every step), recording every contact
+    /// event.
+    pub fn integrate(
+        &self,
+        x0: &[f64],
+        t_end: f64,
+        max_step: f64,
+        output_step: Option<f64>,
+    ) -> Result<Solution> {
+        let opts = Options {
+            max_step,
+            output_step,
+            ..Options::with_tolerances(1e-6, 1e-9)
+        };
+        solve_with_events(
+            &mut MultibodyOde::new(&self.system),
+            Method::TrBdf2,
+            0.0,
+            x0,
+            t_end,
+            &opts,
+            &mut |_, _| EventAction::Record,
+        )
+        .map_err(|e| crate::PianoError::Simulation(e.to_string()))
     }
 
     /// The state at rest as laid out: every coordinate zero, at rest, internal states at

@@ -13,6 +13,9 @@ pub enum PianoError {
         /// What is wrong.
         message: String,
     },
+    /// The integration failed (the integrator's message says when and why).
+    #[error("simulation failed: {0}")]
+    Simulation(String),
     /// The multibody core refused something.
     #[error(transparent)]
     Core(#[from] mbs_core::CoreError),

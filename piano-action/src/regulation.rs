@@ -2,12 +2,11 @@
 //! rest, let-off and drop by a slow key descent, check after a loud blow with the key held,
 //! dip and aftertouch at the key front.
 
-use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::time_function::PiecewiseLinear;
-use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_with_events};
+use mbs_integrators::Solution;
 
 use crate::action::{Action, ModelKind};
-use crate::error::{PianoError, Result};
+use crate::error::Result;
 use crate::params::ActionParams;
 
 /// The regulation achieved (mm), as `piano regulate --json` reports it.
@@ -40,42 +39,9 @@ fn key_depth_mm(params: &ActionParams, q: f64) -> f64 {
 
 /// Runs `action` under a key-front force following `table` ((time, newtons) points).
 fn run(action: &mut Action, table: Vec<(f64, f64)>, t_end: f64, max_step: f64) -> Result<Solution> {
-    let p = &action.params;
-    let model = action.system.model().clone();
-    let at = Attachment::on(
-        "key",
-        [
-            (p.key.finger_mm[0] - p.key.pivot_mm[0]) * 1e-3,
-            (p.key.finger_mm[1] - p.key.pivot_mm[1]) * 1e-3,
-        ],
-    );
-    let force = PiecewiseLinear::new(table)?;
-    action.system.add_element(AppliedLoad::force(
-        &model,
-        "finger",
-        at,
-        [0.0, -1.0],
-        LoadFrame::World,
-        force,
-    )?)?;
+    action.add_key_force(PiecewiseLinear::new(table)?)?;
     let x0 = action.layout_state()?;
-    let opts = Options {
-        max_step,
-        ..Options::with_tolerances(1e-6, 1e-9)
-    };
-    solve_with_events(
-        &mut MultibodyOde::new(&action.system),
-        Method::TrBdf2,
-        0.0,
-        &x0,
-        t_end,
-        &opts,
-        &mut |_, _| EventAction::Record,
-    )
-    .map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("regulation run failed: {e}"),
-    })
+    action.integrate(&x0, t_end, max_step, None)
 }
 
 /// Runs `action` with the key angle prescribed: a smooth move from `q0` to `q1` over
@@ -87,23 +53,7 @@ fn run_motion(action: &mut Action, q0: f64, q1: f64, t_move: f64, t_end: f64) ->
     let x0 = action
         .system
         .initial_state(0.0, &vec![0.0; n], &vec![0.0; n])?;
-    let opts = Options {
-        max_step: 2e-3,
-        ..Options::with_tolerances(1e-6, 1e-9)
-    };
-    solve_with_events(
-        &mut MultibodyOde::new(&action.system),
-        Method::TrBdf2,
-        0.0,
-        &x0,
-        t_end,
-        &opts,
-        &mut |_, _| EventAction::Record,
-    )
-    .map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("regulation run failed: {e}"),
-    })
+    action.integrate(&x0, t_end, 2e-3, None)
 }
 
 /// Measures the regulation of `kind` built from `params`:

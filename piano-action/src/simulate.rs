@@ -1,9 +1,8 @@
 //! Running a keystroke: inputs, the integration, and the piano events and metrics read off
 //! the contact events.
 
-use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::time_function::PiecewiseLinear;
-use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_with_events};
+use mbs_integrators::Solution;
 
 use crate::action::{Action, ModelKind};
 use crate::error::{PianoError, Result};
@@ -115,49 +114,17 @@ pub fn simulate(
     }
     let mut action = Action::build(params, kind)?;
     let model = action.system.model().clone();
-    let finger = params.key.finger_mm;
-    let at = Attachment::on(
-        "key",
-        [
-            (finger[0] - params.key.pivot_mm[0]) * 1e-3,
-            (finger[1] - params.key.pivot_mm[1]) * 1e-3,
-        ],
-    );
     match *input {
         Input::Force { force_n, release_s } => {
             let table = match release_s {
                 None => vec![(0.0, force_n)],
                 Some(t) => vec![(0.0, force_n), (t, force_n), (t + 1e-3, 0.0)],
             };
-            let magnitude = PiecewiseLinear::new(table)?;
-            action.system.add_element(AppliedLoad::force(
-                &model,
-                "finger",
-                at,
-                [0.0, -1.0],
-                LoadFrame::World,
-                magnitude,
-            )?)?;
+            action.add_key_force(PiecewiseLinear::new(table)?)?;
         }
     }
     let x0 = action.layout_state()?;
-    let opts = Options {
-        max_step: 1e-3,
-        ..Options::with_tolerances(1e-6, 1e-9).output_every(output_step_s)
-    };
-    let solution = solve_with_events(
-        &mut MultibodyOde::new(&action.system),
-        Method::TrBdf2,
-        0.0,
-        &x0,
-        duration_s,
-        &opts,
-        &mut |_, _| EventAction::Record,
-    )
-    .map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("simulation failed: {e}"),
-    })?;
+    let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
     let hammer = model.coordinate_id("hammer")?;
     let nv = model.nv();
     let strike_radius = {

@@ -1,9 +1,8 @@
 //! A first dynamic check of the three models: a constant 10 N on the key front (a firm
 //! press), integrated with TR-BDF2, follows the functional sequence of DESIGN.md.
 
-use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::time_function::Constant;
-use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_with_events};
+use mbs_integrators::Solution;
 use piano_action::{Action, ActionParams, ModelKind};
 
 /// Hammer angle (from rest) at which the shank is parallel to the string: string contact.
@@ -11,29 +10,9 @@ const CONTACT_ANGLE: f64 = 19.86 * std::f64::consts::PI / 180.0;
 
 fn press(kind: ModelKind, force: f64, t_end: f64) -> (Action, Solution) {
     let mut action = Action::build(&ActionParams::reference(), kind).unwrap();
-    let model = action.system.model().clone();
-    let finger = AppliedLoad::force(
-        &model,
-        "finger",
-        Attachment::on("key", [-0.218, 0.023]),
-        [0.0, -1.0],
-        LoadFrame::World,
-        Constant(force),
-    )
-    .unwrap();
-    action.system.add_element(finger).unwrap();
+    action.add_key_force(Constant(force)).unwrap();
     let x0 = action.layout_state().unwrap();
-    let opts = Options::with_tolerances(1e-6, 1e-9);
-    let sol = solve_with_events(
-        &mut MultibodyOde::new(&action.system),
-        Method::TrBdf2,
-        0.0,
-        &x0,
-        t_end,
-        &opts,
-        &mut |_, _| EventAction::Record,
-    )
-    .unwrap();
+    let sol = action.integrate(&x0, t_end, f64::INFINITY, None).unwrap();
     (action, sol)
 }
 
