@@ -14,6 +14,7 @@
 mod action;
 mod error;
 pub mod params;
+pub mod pendulum;
 pub mod regulation;
 pub mod simulate;
 
