@@ -17,6 +17,7 @@ pub mod params;
 pub mod pendulum;
 pub mod regulation;
 pub mod simulate;
+pub mod touchweight;
 
 pub use action::{Action, ModelKind};
 pub use error::{PianoError, Result};
