@@ -6,7 +6,9 @@
 //! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts; and a
 //! keystroke driven by a force on the key front, integrated with TR-BDF2, with the piano
 //! events (let-off, string contact, key bottom, check, drop) and the strikes read off the
-//! contact events. Regulation, the other touches, run directories and the full `piano`
+//! contact events; measurement of the regulation ([`regulation::measure`]) and of the
+//! static touchweight ([`touchweight::measure`]); the hammer swing test ([`pendulum`]).
+//! The regulation routine, the other touches, run directories and the rest of the `piano`
 //! command are still to come.
 
 #![warn(missing_docs)]

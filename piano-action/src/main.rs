@@ -28,6 +28,46 @@ enum Command {
     Demo,
     /// Write the default parameter file (with its comments and sources) to standard output.
     Params,
+    /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
+    /// from a slow simulated key descent and ascent.
+    Touchweight {
+        /// Which model.
+        #[arg(long, default_value = "double")]
+        model: String,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn model_kind(name: &str) -> Result<ModelKind, String> {
+    ModelKind::ALL
+        .into_iter()
+        .find(|k| k.name() == name)
+        .ok_or_else(|| format!("unknown model '{name}' (simplified, single or double)"))
+}
+
+fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), String> {
+    let w = piano_action::touchweight::measure(params, model_kind(model)?)
+        .map_err(|e| e.to_string())?;
+    if json {
+        let v = serde_json::json!({
+            "down_weight_gf": w.down_weight_gf,
+            "up_weight_gf": w.up_weight_gf,
+            "balance_weight_gf": w.balance_weight_gf,
+            "friction_weight_gf": w.friction_weight_gf,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!("down weight     {:6.1} gf", w.down_weight_gf);
+        println!("up weight       {:6.1} gf", w.up_weight_gf);
+        println!("balance weight  {:6.1} gf", w.balance_weight_gf);
+        println!("friction weight {:6.1} gf", w.friction_weight_gf);
+    }
+    Ok(())
 }
 
 fn load(path: Option<&std::path::Path>) -> Result<ActionParams, String> {
@@ -85,6 +125,7 @@ fn main() -> ExitCode {
     let result =
         load(cli.params.as_deref()).and_then(|params| match cli.command.unwrap_or(Command::Demo) {
             Command::Demo => demo(&params),
+            Command::Touchweight { model, json } => touchweight(&params, &model, json),
             Command::Params => {
                 use std::io::Write;
                 let _ = std::io::stdout()
