@@ -18,6 +18,7 @@ mod error;
 pub mod params;
 pub mod pendulum;
 pub mod regulation;
+pub mod scenario;
 pub mod simulate;
 pub mod touchweight;
 

@@ -26,6 +26,15 @@ enum Command {
     /// Press the double-escapement action with forces from soft to loud and print a summary
     /// (the default).
     Demo,
+    /// Run a scenario (TOML: `model`, `duration_s`, `[input]`) and write its run directory
+    /// (run.json, trajectory.csv, events.json, summary.json).
+    Simulate {
+        /// The scenario file.
+        scenario: std::path::PathBuf,
+        /// Output directory.
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// Write the default parameter file (with its comments and sources) to standard output.
     Params,
     /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
@@ -38,6 +47,39 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+}
+
+fn simulate_scenario(
+    params: &ActionParams,
+    path: &std::path::Path,
+    out: &std::path::Path,
+) -> Result<(), String> {
+    use piano_action::scenario::{Scenario, write_run_dir};
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let scenario =
+        Scenario::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let kind = scenario
+        .model_kind()
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let run = scenario.run(params).map_err(|e| e.to_string())?;
+    let names = piano_action::Action::build(params, kind)
+        .map_err(|e| e.to_string())?
+        .system
+        .model()
+        .coordinate_names()
+        .to_vec();
+    write_run_dir(out, &scenario, params, &run, &names).map_err(|e| e.to_string())?;
+    for s in &run.strikes {
+        println!(
+            "strike at {:.1} ms, hammer {:.2} m/s, contact {}",
+            s.time_s * 1e3,
+            s.hammer_velocity_m_s,
+            ms(s.contact_duration_s)
+        );
+    }
+    println!("run directory: {}", out.display());
+    Ok(())
 }
 
 fn model_kind(name: &str) -> Result<ModelKind, String> {
@@ -126,6 +168,7 @@ fn main() -> ExitCode {
         load(cli.params.as_deref()).and_then(|params| match cli.command.unwrap_or(Command::Demo) {
             Command::Demo => demo(&params),
             Command::Touchweight { model, json } => touchweight(&params, &model, json),
+            Command::Simulate { scenario, out } => simulate_scenario(&params, &scenario, &out),
             Command::Params => {
                 use std::io::Write;
                 let _ = std::io::stdout()

@@ -46,3 +46,54 @@ fn touchweight_json_reports_the_four_weights() {
     let (ok, _, err) = piano(&["touchweight", "--model", "upright"]);
     assert!(!ok && err.contains("unknown model 'upright'"), "{err}");
 }
+
+#[test]
+fn simulate_writes_a_run_directory_with_the_summary() {
+    let dir = std::env::temp_dir().join(format!("piano-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = dir.join("loud.toml");
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.08\n[input]\nkind = \"force\"\nforce_n = 20.0\n",
+    )
+    .unwrap();
+    let out = dir.join("run");
+    let (ok, stdout, err) = piano(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("strike at"), "{stdout}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let strikes = summary["strikes"].as_array().unwrap();
+    assert!(!strikes.is_empty());
+    let v = strikes[0]["hammer_velocity_m_s"].as_f64().unwrap();
+    assert!((4.0..7.0).contains(&v), "loud strike at {v} m/s");
+    assert!(summary["let_off_time_s"].as_f64().unwrap() < strikes[0]["time_s"].as_f64().unwrap());
+    assert!(summary["events"].as_array().unwrap().len() >= 4);
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(
+        csv.starts_with("time_s,key_q,wippen_q,jack_q,repetition_lever_q,hammer_q,key_v"),
+        "{}",
+        &csv[..80]
+    );
+    assert_eq!(csv.lines().count(), 1 + 81, "header and 81 grid rows");
+    assert!(out.join("run.json").exists() && out.join("events.json").exists());
+    // A bad scenario names the field.
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.08\n[input]\nkind = \"force\"\nforce = 20.0\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("input"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

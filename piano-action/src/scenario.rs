@@ -1,0 +1,166 @@
+//! Scenarios (what `piano simulate SCENARIO.toml` runs) and run directories (what it
+//! writes: `run.json`, `trajectory.csv`, `events.json`, `summary.json`).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::action::ModelKind;
+use crate::error::{PianoError, Result};
+use crate::params::ActionParams;
+use crate::simulate::{Input, Run, simulate};
+
+/// The input of a scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum InputSpec {
+    /// A force on the key front (N), optionally released at `release_s`.
+    Force {
+        /// Force (N).
+        force_n: f64,
+        /// Release time (s).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        release_s: Option<f64>,
+    },
+}
+
+/// A scenario file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// `"simplified"`, `"single"` or `"double"`.
+    pub model: String,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Output grid spacing (s); 1 ms by default.
+    #[serde(default = "default_output_step")]
+    pub output_step_s: f64,
+    /// What drives the key.
+    pub input: InputSpec,
+}
+
+fn default_output_step() -> f64 {
+    1e-3
+}
+
+impl Scenario {
+    /// Parses a scenario; errors name the field.
+    pub fn from_toml_str(text: &str) -> Result<Self> {
+        let de = toml::Deserializer::parse(text).map_err(|e| PianoError::Params {
+            field: String::new(),
+            message: e.to_string(),
+        })?;
+        serde_path_to_error::deserialize(de).map_err(|e| PianoError::Params {
+            field: e.path().to_string(),
+            message: e.inner().to_string(),
+        })
+    }
+
+    /// The model kind named by `model`.
+    pub fn model_kind(&self) -> Result<ModelKind> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == self.model)
+            .ok_or_else(|| PianoError::Params {
+                field: "model".into(),
+                message: format!(
+                    "unknown model '{}' (simplified, single or double)",
+                    self.model
+                ),
+            })
+    }
+
+    /// Runs the scenario.
+    pub fn run(&self, params: &ActionParams) -> Result<Run> {
+        let input = match self.input {
+            InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
+        };
+        simulate(
+            params,
+            self.model_kind()?,
+            &input,
+            self.duration_s,
+            self.output_step_s,
+        )
+    }
+}
+
+fn num(x: Option<f64>) -> serde_json::Value {
+    x.map_or(serde_json::Value::Null, serde_json::Value::from)
+}
+
+/// Writes the run directory `dir` (created if needed): `run.json` (scenario and
+/// parameters), `trajectory.csv` (time, coordinates, velocities on the output grid),
+/// `events.json` and `summary.json` (strikes, let-off, key-bottom and check times, events).
+pub fn write_run_dir(
+    dir: &Path,
+    scenario: &Scenario,
+    params: &ActionParams,
+    run: &Run,
+    names: &[String],
+) -> Result<()> {
+    let io = |e: std::io::Error, what: &str| PianoError::Params {
+        field: String::new(),
+        message: format!("cannot write {}: {e}", dir.join(what).display()),
+    };
+    std::fs::create_dir_all(dir).map_err(|e| io(e, ""))?;
+    let json = |v: &serde_json::Value| serde_json::to_string_pretty(v).unwrap_or_default();
+    let run_json = serde_json::json!({
+        "scenario": serde_json::to_value(scenario).unwrap_or_default(),
+        "params": serde_json::to_value(params).unwrap_or_default(),
+        "version": env!("CARGO_PKG_VERSION"),
+    });
+    std::fs::write(dir.join("run.json"), json(&run_json)).map_err(|e| io(e, "run.json"))?;
+
+    let sol = &run.solution;
+    let nv = names.len();
+    let mut csv = String::from("time_s");
+    for n in names {
+        let _ = write!(csv, ",{n}_q");
+    }
+    for n in names {
+        let _ = write!(csv, ",{n}_v");
+    }
+    csv.push('\n');
+    for i in 0..sol.len() {
+        let _ = write!(csv, "{}", sol.t[i]);
+        for v in &sol.state(i)[..2 * nv] {
+            let _ = write!(csv, ",{v}");
+        }
+        csv.push('\n');
+    }
+    std::fs::write(dir.join("trajectory.csv"), csv).map_err(|e| io(e, "trajectory.csv"))?;
+
+    let events: Vec<serde_json::Value> = run
+        .events
+        .iter()
+        .map(|e| serde_json::json!({"name": e.name, "time_s": e.time_s}))
+        .collect();
+    std::fs::write(
+        dir.join("events.json"),
+        json(&serde_json::Value::from(events.clone())),
+    )
+    .map_err(|e| io(e, "events.json"))?;
+    let strikes: Vec<serde_json::Value> = run
+        .strikes
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "time_s": s.time_s,
+                "hammer_velocity_m_s": s.hammer_velocity_m_s,
+                "contact_duration_s": num(s.contact_duration_s),
+            })
+        })
+        .collect();
+    let summary = serde_json::json!({
+        "model": run.kind.name(),
+        "strikes": strikes,
+        "let_off_time_s": num(run.let_off_time_s),
+        "key_bottom_time_s": num(run.key_bottom_time_s),
+        "check_time_s": num(run.check_time_s),
+        "events": events,
+    });
+    std::fs::write(dir.join("summary.json"), json(&summary)).map_err(|e| io(e, "summary.json"))?;
+    Ok(())
+}
