@@ -507,8 +507,9 @@ impl Action {
             .initial_state(0.0, &vec![0.0; n], &vec![0.0; n])?)
     }
 
-    /// The gap (m) of the named contact at state `x`.
-    pub fn gap(&self, name: &str, x: &[f64]) -> Result<f64> {
+    /// The gap (m) of the named contact at time `t` and state `x` (the time matters when a
+    /// coordinate is prescribed: the drive, not the state, then places it).
+    pub fn gap(&self, name: &str, t: f64, x: &[f64]) -> Result<f64> {
         let e = *self
             .contacts
             .get(name)
@@ -517,7 +518,7 @@ impl Action {
                 name: name.to_string(),
             })?;
         let mut ws = self.system.workspace();
-        let ctx = self.system.element_context(&mut ws, 0.0, x, e)?;
+        let ctx = self.system.element_context(&mut ws, t, x, e)?;
         let mut g = [0.0];
         if let Some(el) = self.system.elements().nth(e) {
             el.switching_functions(&ctx, &mut g);

@@ -37,6 +37,20 @@ enum Command {
     },
     /// Write the default parameter file (with its comments and sources) to standard output.
     Params,
+    /// Regulate the action like a technician (front-rail punching, capstan, let-off button,
+    /// drop screw, backcheck, rest rail) to the middle of the literature bands and print
+    /// what it achieves: key dip, blow distance, let-off, drop, check, aftertouch (mm).
+    Regulate {
+        /// Which model.
+        #[arg(long, default_value = "double")]
+        model: String,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Also write the regulated parameter file here (refuses to overwrite a file).
+        #[arg(long)]
+        write: Option<std::path::PathBuf>,
+    },
     /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
     /// from a slow simulated key descent and ascent.
     Touchweight {
@@ -112,6 +126,81 @@ fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), Str
     Ok(())
 }
 
+fn regulate(
+    params: &ActionParams,
+    model: &str,
+    json: bool,
+    write: Option<&std::path::Path>,
+) -> Result<(), String> {
+    use piano_action::regulation::{Targets, regulate};
+    let kind = model_kind(model)?;
+    if let Some(path) = write
+        && path.exists()
+    {
+        return Err(format!(
+            "{} exists; choose a new file for the regulated parameters",
+            path.display()
+        ));
+    }
+    let done = regulate(params, kind, &Targets::default()).map_err(|e| e.to_string())?;
+    let r = &done.achieved;
+    let g = &done.params.regulation;
+    if json {
+        let v = serde_json::json!({
+            "model": kind.name(),
+            "key_dip_mm": r.key_dip_mm,
+            "blow_distance_mm": r.blow_distance_mm,
+            "let_off_mm": r.let_off_mm,
+            "drop_mm": r.drop_mm,
+            "check_mm": r.check_mm,
+            "aftertouch_mm": r.aftertouch_mm,
+            "in_band": done.out_of_band.is_empty(),
+            "out_of_band": done.out_of_band,
+            "measurements": done.measurements,
+            "settings": serde_json::to_value(g).map_err(|e| e.to_string())?,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
+        );
+    } else {
+        let mm = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2}"));
+        println!(
+            "Regulated {} action ({} measurements):",
+            kind.name(),
+            done.measurements
+        );
+        println!(
+            "  key dip        {:>6} mm   (9.5-11)",
+            mm(Some(r.key_dip_mm))
+        );
+        println!(
+            "  blow distance  {:>6} mm   (44-48)",
+            mm(Some(r.blow_distance_mm))
+        );
+        println!("  let-off        {:>6} mm   (1.5-2.5)", mm(r.let_off_mm));
+        println!("  drop           {:>6} mm   (0.5-2)", mm(r.drop_mm));
+        println!("  check          {:>6} mm   (12-16)", mm(r.check_mm));
+        println!("  aftertouch     {:>6} mm   (0.5-1.5)", mm(r.aftertouch_mm));
+        println!("Settings:");
+        println!("  front-rail punching top {:8.3} mm", g.front_rail_top_y_mm);
+        println!("  capstan raised          {:8.3} mm", g.capstan_raise_mm);
+        println!("  let-off button          {:8.3} mm", g.let_off_button_y_mm);
+        println!("  drop screw              {:8.3} mm", g.drop_screw_y_mm);
+        println!("  backcheck offset        {:8.3} mm", g.backcheck_offset_mm);
+        println!("  rest-rail top           {:8.3} mm", g.rest_rail_top_y_mm);
+        if !done.out_of_band.is_empty() {
+            println!("Out of band: {}", done.out_of_band.join(", "));
+        }
+    }
+    if let Some(path) = write {
+        let text = done.params.to_toml_string().map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        eprintln!("regulated parameters written to {}", path.display());
+    }
+    Ok(())
+}
+
 fn load(path: Option<&std::path::Path>) -> Result<ActionParams, String> {
     match path {
         None => Ok(ActionParams::reference()),
@@ -168,6 +257,9 @@ fn main() -> ExitCode {
         load(cli.params.as_deref()).and_then(|params| match cli.command.unwrap_or(Command::Demo) {
             Command::Demo => demo(&params),
             Command::Touchweight { model, json } => touchweight(&params, &model, json),
+            Command::Regulate { model, json, write } => {
+                regulate(&params, &model, json, write.as_deref())
+            }
             Command::Simulate { scenario, out } => simulate_scenario(&params, &scenario, &out),
             Command::Params => {
                 use std::io::Write;

@@ -137,7 +137,7 @@ pub fn simulate(
         for (contact, on, off) in EVENT_NAMES {
             if ev.name == format!("contact '{contact}' #0") {
                 // The event state is just past the crossing: a negative gap is an onset.
-                let onset = action.gap(contact, &ev.state)? < 0.0;
+                let onset = action.gap(contact, ev.time, &ev.state)? < 0.0;
                 events.push(PianoEvent {
                     name: if onset { on } else { off },
                     time_s: ev.time,

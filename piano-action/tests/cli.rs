@@ -97,3 +97,37 @@ fn simulate_writes_a_run_directory_with_the_summary() {
     assert!(!ok && err.contains("input"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn regulate_json_reports_the_six_measurements_in_band_and_writes_the_file() {
+    let dir = std::env::temp_dir().join(format!("piano-regulate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("regulated.toml");
+    let (ok, out, err) = piano(&[
+        "regulate",
+        "--json",
+        "--model",
+        "single",
+        "--write",
+        file.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let band = |name: &str, lo: f64, hi: f64| {
+        let x = v[name].as_f64().unwrap_or(f64::NAN);
+        assert!((lo..=hi).contains(&x), "{name} = {x}");
+    };
+    band("key_dip_mm", 9.5, 11.0);
+    band("blow_distance_mm", 44.0, 48.0);
+    band("let_off_mm", 1.5, 2.5);
+    band("check_mm", 12.0, 16.0);
+    band("aftertouch_mm", 0.5, 1.5);
+    // The single action has no repetition lever, hence no drop.
+    assert!(v["drop_mm"].is_null());
+    // The written file loads, and a second run refuses to overwrite it.
+    let text = std::fs::read_to_string(&file).unwrap();
+    piano_action::ActionParams::from_toml_str(&text).unwrap();
+    let (ok, _, err) = piano(&["regulate", "--write", file.to_str().unwrap()]);
+    assert!(!ok && err.contains("exists"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
