@@ -23,6 +23,11 @@ pub enum InputSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         release_s: Option<f64>,
     },
+    /// Prescribed key-front depth, `points = [[time_s, depth_mm], ...]`, piecewise linear.
+    Motion {
+        /// `[time_s, depth_mm]` points.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 /// A scenario file.
@@ -73,8 +78,11 @@ impl Scenario {
 
     /// Runs the scenario.
     pub fn run(&self, params: &ActionParams) -> Result<Run> {
-        let input = match self.input {
-            InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
+        let input = match &self.input {
+            &InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
+            InputSpec::Motion { points } => Input::Motion {
+                points: points.iter().map(|p| (p[0], p[1])).collect(),
+            },
         };
         simulate(
             params,
@@ -122,11 +130,18 @@ pub fn write_run_dir(
     for n in names {
         let _ = write!(csv, ",{n}_v");
     }
+    let with_force = run.key_drive_force_n.len() == sol.len();
+    if with_force {
+        csv.push_str(",key_drive_force_n");
+    }
     csv.push('\n');
     for i in 0..sol.len() {
         let _ = write!(csv, "{}", sol.t[i]);
         for v in &sol.state(i)[..2 * nv] {
             let _ = write!(csv, ",{v}");
+        }
+        if with_force {
+            let _ = write!(csv, ",{}", run.key_drive_force_n[i]);
         }
         csv.push('\n');
     }

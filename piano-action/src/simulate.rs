@@ -1,7 +1,7 @@
 //! Running a keystroke: inputs, the integration, and the piano events and metrics read off
 //! the contact events.
 
-use mbs_core::time_function::PiecewiseLinear;
+use mbs_core::time_function::{Drive, DriveState, PiecewiseLinear};
 use mbs_integrators::Solution;
 
 use crate::action::{Action, ModelKind};
@@ -18,6 +18,15 @@ pub enum Input {
         force_n: f64,
         /// Release time (s).
         release_s: Option<f64>,
+    },
+    /// Prescribed key-front depth: `(time_s, depth_mm)` points, piecewise linear (corners
+    /// rounded over at most 5 ms so the key's acceleration stays finite), held before the
+    /// first point and after the last. Depth is measured at the finger point from the
+    /// layout's rest position, positive down. The force the hand needs is in
+    /// [`Run::key_drive_force_n`].
+    Motion {
+        /// `(time_s, depth_mm)` points, times increasing.
+        points: Vec<(f64, f64)>,
     },
 }
 
@@ -41,6 +50,133 @@ impl Input {
                 }
                 Ok(())
             }
+            Input::Motion { ref points } => {
+                let bad = |message: String| PianoError::Params {
+                    field: "input.points".into(),
+                    message,
+                };
+                if points.is_empty() {
+                    return Err(bad("needs at least one [time_s, depth_mm] point".into()));
+                }
+                for (i, &(t, d)) in points.iter().enumerate() {
+                    if !(t.is_finite() && d.is_finite()) {
+                        return Err(bad(format!("point {i} is not finite: [{t}, {d}]")));
+                    }
+                    if !(-20.0..=20.0).contains(&d) {
+                        return Err(bad(format!(
+                            "point {i}: depth {d} mm is outside -20..20 mm (a key dips about 10)"
+                        )));
+                    }
+                    if i > 0 && t <= points[i - 1].0 {
+                        return Err(bad(format!(
+                            "point {i}: times must increase, got {t} after {}",
+                            points[i - 1].0
+                        )));
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// The key angle (rad) that puts the finger point `depth_mm` below its layout position.
+pub fn key_angle_for_depth(params: &ActionParams, depth_mm: f64) -> f64 {
+    let fx = params.key.finger_mm[0] - params.key.pivot_mm[0];
+    let fy = params.key.finger_mm[1] - params.key.pivot_mm[1];
+    // depth(q) = fy − (fx sin q + fy cos q); Newton from the small-angle guess.
+    let mut q = depth_mm / (fx * fx + fy * fy).sqrt();
+    for _ in 0..6 {
+        let (s, c) = q.sin_cos();
+        let f = fy - (fx * s + fy * c) - depth_mm;
+        let df = -(fx * c - fy * s);
+        q -= f / df;
+    }
+    q
+}
+
+/// A piecewise-linear motion whose corners are rounded by parabolic blends (C¹, finite
+/// acceleration), constant before the first and after the last point.
+#[derive(Clone, Debug)]
+pub struct BlendedLinear {
+    t: Vec<f64>,
+    q: Vec<f64>,
+    /// Half-width of the blend at each point (s).
+    tau: Vec<f64>,
+}
+
+impl BlendedLinear {
+    /// Builds the motion through `(t, q)` points (times increasing, at least one), each
+    /// corner rounded over `2 τ` with `τ = min(max_blend_s, a quarter of each side)`.
+    pub fn new(points: &[(f64, f64)], max_blend_s: f64) -> Self {
+        let t: Vec<f64> = points.iter().map(|p| p.0).collect();
+        let q: Vec<f64> = points.iter().map(|p| p.1).collect();
+        let n = t.len();
+        let tau = (0..n)
+            .map(|k| {
+                let before = if k > 0 {
+                    t[k] - t[k - 1]
+                } else {
+                    f64::INFINITY
+                };
+                let after = if k + 1 < n {
+                    t[k + 1] - t[k]
+                } else {
+                    f64::INFINITY
+                };
+                max_blend_s.min(0.25 * before).min(0.25 * after)
+            })
+            .collect();
+        BlendedLinear { t, q, tau }
+    }
+
+    /// Slope of segment `i` (between points `i` and `i + 1`); 0 outside the table.
+    fn slope(&self, i: isize) -> f64 {
+        if i < 0 || i as usize + 1 >= self.t.len() {
+            0.0
+        } else {
+            let i = i as usize;
+            (self.q[i + 1] - self.q[i]) / (self.t[i + 1] - self.t[i])
+        }
+    }
+}
+
+impl Drive for BlendedLinear {
+    fn eval(&self, t: f64) -> DriveState {
+        let n = self.t.len();
+        // Inside a corner blend?
+        for k in 0..n {
+            let (tk, tau) = (self.t[k], self.tau[k]);
+            if tau > 0.0 && (t - tk).abs() < tau {
+                let (m0, m1) = (self.slope(k as isize - 1), self.slope(k as isize));
+                let s = t - tk + tau;
+                return DriveState {
+                    q: self.q[k] + m0 * (t - tk) + (m1 - m0) * s * s / (4.0 * tau),
+                    v: m0 + (m1 - m0) * s / (2.0 * tau),
+                    a: (m1 - m0) / (2.0 * tau),
+                };
+            }
+        }
+        if t <= self.t[0] {
+            return DriveState {
+                q: self.q[0],
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        if t >= self.t[n - 1] {
+            return DriveState {
+                q: self.q[n - 1],
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        let i = self.t.partition_point(|&tk| tk <= t) - 1;
+        let m = self.slope(i as isize);
+        DriveState {
+            q: self.q[i] + m * (t - self.t[i]),
+            v: m,
+            a: 0.0,
         }
     }
 }
@@ -82,6 +218,9 @@ pub struct Run {
     pub key_bottom_time_s: Option<f64>,
     /// First check (hammer tail caught after a strike) (s).
     pub check_time_s: Option<f64>,
+    /// Under a prescribed key motion, the vertical force the hand applies at the finger
+    /// point (N, pressing down positive) on the output grid; empty otherwise.
+    pub key_drive_force_n: Vec<f64>,
 }
 
 /// Contacts whose onset and release are piano events.
@@ -122,11 +261,40 @@ pub fn simulate(
             };
             action.add_key_force(PiecewiseLinear::new(table)?)?;
         }
+        Input::Motion { ref points } => {
+            let table: Vec<(f64, f64)> = points
+                .iter()
+                .map(|&(t, d)| (t, key_angle_for_depth(params, d)))
+                .collect();
+            action
+                .system
+                .prescribe("key", BlendedLinear::new(&table, 5e-3))?;
+        }
     }
-    let x0 = action.layout_state()?;
-    let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
-    let hammer = model.coordinate_id("hammer")?;
     let nv = model.nv();
+    let x0 = action
+        .system
+        .initial_state(0.0, &vec![0.0; nv], &vec![0.0; nv])?;
+    let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
+    let mut key_drive_force_n = Vec::new();
+    if matches!(input, Input::Motion { .. }) {
+        let key = model.coordinate_id("key")?;
+        let mut ws = action.system.workspace();
+        let mut dx = vec![0.0; action.system.state_len()];
+        for i in 0..solution.len() {
+            let (t, x) = (solution.t[i], solution.state(i));
+            action.system.derivative(&mut ws, t, x, &mut dx)?;
+            // The torque the drive applies about the balance pivot, as a vertical force at
+            // the finger point (the lever arm is its horizontal distance).
+            let q = x[key];
+            let f = &params.key.finger_mm;
+            let arm = ((f[0] - params.key.pivot_mm[0]) * q.cos()
+                - (f[1] - params.key.pivot_mm[1]) * q.sin())
+                * 1e-3;
+            key_drive_force_n.push(-ws.drive_forces()[key] / arm);
+        }
+    }
+    let hammer = model.coordinate_id("hammer")?;
     let strike_radius = {
         let s = params.hammer.strike_body_mm;
         (s[0] * s[0] + s[1] * s[1]).sqrt() * 1e-3
@@ -172,5 +340,6 @@ pub fn simulate(
         solution,
         events,
         strikes,
+        key_drive_force_n,
     })
 }

@@ -82,6 +82,37 @@ fn simulate_writes_a_run_directory_with_the_summary() {
     );
     assert_eq!(csv.lines().count(), 1 + 81, "header and 81 grid rows");
     assert!(out.join("run.json").exists() && out.join("events.json").exists());
+    // A key-motion scenario: a quick 10 mm press in 20 ms strikes, and the hand's force is
+    // in the trajectory.
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.06\n[input]\nkind = \"motion\"\npoints = [[0.0, 0.0], [0.02, 10.0]]\n",
+    )
+    .unwrap();
+    let moved = dir.join("moved");
+    let (ok, stdout, err) = piano(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        moved.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("strike at"), "{stdout}");
+    let csv = std::fs::read_to_string(moved.join("trajectory.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",key_drive_force_n"));
+    // Times that go backwards are refused, naming the field.
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.06\n[input]\nkind = \"motion\"\npoints = [[0.02, 0.0], [0.01, 10.0]]\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        moved.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("input.points"), "{err}");
     // A bad scenario names the field.
     std::fs::write(
         &scenario,
