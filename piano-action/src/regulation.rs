@@ -381,7 +381,7 @@ fn done_except_aftertouch(r: &Regulation, kind: ModelKind) -> bool {
 /// blow with the capstan (the rest rail following at its clearance under the shank),
 /// let-off with the button, drop with the drop screw, check with the backcheck. Then, if
 /// the aftertouch is off, the dip is retargeted within its band (more dip, more
-/// aftertouch) and the sweep repeated.
+/// aftertouch), and past its band the blow, and the sweep repeated.
 ///
 /// Returns what was achieved even when a band is missed (listed in
 /// [`Regulated::out_of_band`]); errors only if a parameter is invalid or a simulation fails.
@@ -390,6 +390,7 @@ pub fn regulate(params: &ActionParams, kind: ModelKind, targets: &Targets) -> Re
     let mut p = params.clone();
     let count = std::cell::Cell::new(0_usize);
     let mut dip_target = targets.key_dip_mm;
+    let mut blow_target = targets.blow_distance_mm;
     let mut r = measure_full(&p, kind)?.0;
     for _sweep in 0..6 {
         // Dip: the front-rail punching (raising it shortens the dip).
@@ -413,7 +414,7 @@ pub fn regulate(params: &ActionParams, kind: ModelKind, targets: &Targets) -> Re
             &mut p,
             |p| p.regulation.capstan_raise_mm,
             |p, v| p.regulation.capstan_raise_mm = v,
-            targets.blow_distance_mm,
+            blow_target,
             0.25,
             -9.0,
             1.0,
@@ -482,16 +483,21 @@ pub fn regulate(params: &ActionParams, kind: ModelKind, targets: &Targets) -> Re
         count.set(count.get() + 1);
         let mut done = BANDS.violations(&r, kind).is_empty();
         // Aftertouch is read, not screwed: once the rest is in, retarget the dip within its
-        // band.
+        // band; what the dip cannot take, the blow takes (a higher hammer line needs more
+        // key travel to let off, leaving less aftertouch), at about 5.5 mm per mm.
         if let Some(after) = r.aftertouch_mm
             && done_except_aftertouch(&r, kind)
             && (after - targets.aftertouch_mm).abs() > 0.25
         {
             let (lo, hi) = BANDS.key_dip_mm;
-            let new_target =
-                (dip_target + targets.aftertouch_mm - after).clamp(lo + 0.15, hi - 0.15);
-            if (new_target - dip_target).abs() > 0.05 {
-                dip_target = new_target;
+            let wanted = dip_target + targets.aftertouch_mm - after;
+            let new_dip = wanted.clamp(lo + 0.15, hi - 0.15);
+            let rest = wanted - new_dip;
+            let (blo, bhi) = BANDS.blow_distance_mm;
+            let new_blow = (blow_target - 5.5 * rest).clamp(blo + 0.5, bhi - 0.5);
+            if (new_dip - dip_target).abs() > 0.05 || (new_blow - blow_target).abs() > 0.1 {
+                dip_target = new_dip;
+                blow_target = new_blow;
                 done = false;
             }
         }

@@ -73,8 +73,11 @@ fn the_simplified_action_pushes_the_hammer_to_the_string_and_holds_it_there() {
     let (action, run) = slow_press(ModelKind::Simplified);
     let ev = names(&run);
     println!("{ev:?}");
-    assert_eq!(run.strikes.len(), 1, "{ev:?}");
-    assert!(run.strikes[0].contact_duration_s.is_none(), "{ev:?}");
+    // The crown arrives slowly (it may settle with a bounce or two of the stiff string
+    // contact) and stays: the run ends in contact.
+    assert!(!run.strikes.is_empty(), "{ev:?}");
+    let last = run.strikes.last().unwrap();
+    assert!(last.contact_duration_s.is_none(), "{ev:?}");
     let sol = &run.solution;
     assert!(
         action
@@ -83,5 +86,9 @@ fn the_simplified_action_pushes_the_hammer_to_the_string_and_holds_it_there() {
             < 0.0
     );
     // A quasi-static arrival, not a blow.
-    assert!(run.strikes[0].hammer_velocity_m_s < 0.1);
+    assert!(
+        run.strikes.iter().all(|s| s.hammer_velocity_m_s < 0.1),
+        "{:?}",
+        run.strikes
+    );
 }
