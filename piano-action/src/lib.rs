@@ -3,14 +3,16 @@
 //! **In progress.** Built so far: the parameter set (one documented TOML file, embedded as
 //! the default, loaded with errors that name the field); the three progressive models
 //! (simplified, single escapement, double escapement) assembled from it as
-//! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts; and a
-//! keystroke driven by a force on the key front, integrated with TR-BDF2, with the piano
-//! events (let-off, string contact, key bottom, check, drop) and the strikes read off the
-//! contact events; measurement of the regulation ([`regulation::measure`]) and of the
-//! static touchweight ([`touchweight::measure`]); the hammer swing test ([`pendulum`]).
-//! The regulation routine, the other touches, run directories and the rest of the `piano`
-//! command are still to come.
-
+//! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts;
+//! keystrokes driven by a force on the key front or by a prescribed key-front motion (with
+//! the hand's force reported), integrated with TR-BDF2, with the piano events (let-off,
+//! string contact, key bottom, check, drop) and the strikes read off the contact events;
+//! the regulation measured and regulated into the literature bands
+//! ([`regulation::measure`], [`regulation::regulate`]); the static touchweight
+//! ([`touchweight::measure`]); the hammer swing test ([`pendulum`]); scenarios and run
+//! directories ([`scenario`]). Finger touches, the mass drop, repeated notes, drawings and
+//! `piano sweep` are still to come.
+//!
 #![warn(missing_docs)]
 
 mod action;
