@@ -97,10 +97,44 @@ fn circle(c: [f64; 2], r_mm: f64) -> Result<Shape> {
     Ok(Shape::circle(m(c), r_mm * 1e-3)?)
 }
 
+/// A weight resting on (or dropped onto) the key front: a body sliding vertically over the
+/// finger point, touching the key top through a firm pad (the 1 kg experiment).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Presser {
+    /// Its mass (kg).
+    pub mass_kg: f64,
+    /// Height of its pad above the key top at t = 0 (mm; 0 = resting on it).
+    pub height_mm: f64,
+}
+
 impl Action {
     /// Assembles `kind` from `params`.
     pub fn build(params: &ActionParams, kind: ModelKind) -> Result<Action> {
+        Self::build_with(params, kind, None)
+    }
+
+    /// Assembles `kind` from `params` with a [`Presser`] over the key front (coordinate
+    /// `"presser"`, positive up, 0 at its starting height; contact `"presser_key"`).
+    pub fn build_with(
+        params: &ActionParams,
+        kind: ModelKind,
+        presser: Option<Presser>,
+    ) -> Result<Action> {
         params.validate()?;
+        if let Some(pr) = presser
+            && !(pr.mass_kg.is_finite()
+                && pr.mass_kg > 0.0
+                && pr.height_mm.is_finite()
+                && (0.0..=500.0).contains(&pr.height_mm))
+        {
+            return Err(crate::PianoError::Params {
+                field: "input".into(),
+                message: format!(
+                    "the mass must be positive and its height 0-500 mm, got {} kg at {} mm",
+                    pr.mass_kg, pr.height_mm
+                ),
+            });
+        }
         let p = params;
         let (k, w, j, r, h) = (&p.key, &p.wippen, &p.jack, &p.repetition_lever, &p.hammer);
         let with_jack = kind != ModelKind::Simplified;
@@ -170,6 +204,19 @@ impl Action {
             ),
             BodySpec::new(h.mass_g * 1e-3, m(h.com_body_mm), h.inertia_com_kg_m2),
         );
+        const PAD_RADIUS_MM: f64 = 5.0;
+        if let Some(pr) = presser {
+            b.add_link(
+                "presser",
+                None,
+                JointKind::Prismatic { axis: [0.0, 1.0] },
+                Placement::offset(
+                    k.finger_mm[0] * 1e-3,
+                    (k.finger_mm[1] + PAD_RADIUS_MM + pr.height_mm) * 1e-3,
+                ),
+                BodySpec::new(pr.mass_kg, [0.0, 0.0], pr.mass_kg * 1e-4),
+            );
+        }
         let model = b.build()?;
         let mut system = System::new(model.clone());
 
@@ -442,6 +489,28 @@ impl Action {
             &c.hammer_string,
             &mut system,
         )?;
+        if presser.is_some() {
+            let pad = ContactParams {
+                k: 1.0e7,
+                p: 1.5,
+                e: 0.5,
+                mu: 0.0,
+            };
+            let kf = [k.finger_mm[0] - kp[0], k.finger_mm[1] - kp[1]];
+            add(
+                "presser_key",
+                ContactSide::on(
+                    "key",
+                    vec![Shape::segment(
+                        m([kf[0] - 12.0, kf[1]]),
+                        m([kf[0] + 12.0, kf[1]]),
+                    )?],
+                ),
+                ContactSide::on("presser", vec![circle([0.0, 0.0], PAD_RADIUS_MM)?]),
+                &pad,
+                &mut system,
+            )?;
+        }
         Ok(Action {
             kind,
             params: params.clone(),

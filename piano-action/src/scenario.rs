@@ -23,6 +23,13 @@ pub enum InputSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         release_s: Option<f64>,
     },
+    /// A mass released on the key front from `height_m` (0: placed on it).
+    MassDrop {
+        /// Mass (kg).
+        mass_kg: f64,
+        /// Drop height (m).
+        height_m: f64,
+    },
     /// Prescribed key-front depth, `points = [[time_s, depth_mm], ...]`, piecewise linear.
     Motion {
         /// `[time_s, depth_mm]` points.
@@ -80,6 +87,7 @@ impl Scenario {
     pub fn run(&self, params: &ActionParams) -> Result<Run> {
         let input = match &self.input {
             &InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
+            &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
             InputSpec::Motion { points } => Input::Motion {
                 points: points.iter().map(|p| (p[0], p[1])).collect(),
             },

@@ -28,6 +28,14 @@ pub enum Input {
         /// `(time_s, depth_mm)` points, times increasing.
         points: Vec<(f64, f64)>,
     },
+    /// A mass released at rest `height_m` above the key front (0: placed on it), falling
+    /// onto it through a firm pad (the 1 kg experiment).
+    MassDrop {
+        /// Mass (kg).
+        mass_kg: f64,
+        /// Drop height (m).
+        height_m: f64,
+    },
 }
 
 impl Input {
@@ -46,6 +54,21 @@ impl Input {
                     return Err(PianoError::Params {
                         field: "input.release_s".into(),
                         message: format!("must be positive, got {t}"),
+                    });
+                }
+                Ok(())
+            }
+            Input::MassDrop { mass_kg, height_m } => {
+                if !(mass_kg.is_finite() && mass_kg > 0.0 && mass_kg <= 20.0) {
+                    return Err(PianoError::Params {
+                        field: "input.mass_kg".into(),
+                        message: format!("must be a mass of up to 20 kg, got {mass_kg}"),
+                    });
+                }
+                if !(height_m.is_finite() && (0.0..=0.5).contains(&height_m)) {
+                    return Err(PianoError::Params {
+                        field: "input.height_m".into(),
+                        message: format!("must be 0 to 0.5 m, got {height_m}"),
                     });
                 }
                 Ok(())
@@ -251,9 +274,17 @@ pub fn simulate(
             message: format!("must be positive, got {duration_s}"),
         });
     }
-    let mut action = Action::build(params, kind)?;
+    let presser = match *input {
+        Input::MassDrop { mass_kg, height_m } => Some(crate::action::Presser {
+            mass_kg,
+            height_mm: height_m * 1e3,
+        }),
+        _ => None,
+    };
+    let mut action = Action::build_with(params, kind, presser)?;
     let model = action.system.model().clone();
     match *input {
+        Input::MassDrop { .. } => {}
         Input::Force { force_n, release_s } => {
             let table = match release_s {
                 None => vec![(0.0, force_n)],
