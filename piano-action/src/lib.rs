@@ -5,13 +5,13 @@
 //! (simplified, single escapement, double escapement) assembled from it as
 //! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts;
 //! keystrokes driven by a force on the key front, by a prescribed key-front motion (with
-//! the hand's force reported) or by a mass dropped on the key, integrated with TR-BDF2, with the piano events (let-off,
-//! string contact, key bottom, check, drop) and the strikes read off the contact events;
-//! the regulation measured and regulated into the literature bands
+//! the hand's force reported) or by a mass dropped on the key, integrated with TR-BDF2, with
+//! the piano events (let-off, string contact, key bottom, check, drop) and the strikes read
+//! off the contact events; the regulation measured and regulated into the literature bands
 //! ([`regulation::measure`], [`regulation::regulate`]); the static touchweight
 //! ([`touchweight::measure`]); the hammer swing test ([`pendulum`]); scenarios and run
-//! directories ([`scenario`]). Finger touches, the pendulum as a scenario, drawings and `piano
-//! sweep` are still to come.
+//! directories ([`scenario`]). Finger touches, the pendulum as a scenario, drawings and
+//! `piano sweep` are still to come.
 //!
 #![warn(missing_docs)]
 
