@@ -10,8 +10,8 @@
 //! off the contact events; the regulation measured and regulated into the literature bands
 //! ([`regulation::measure`], [`regulation::regulate`]); the static touchweight
 //! ([`touchweight::measure`]); the hammer swing test ([`pendulum`]); scenarios and run
-//! directories ([`scenario`]). Finger touches, the pendulum as a scenario, drawings and
-//! `piano sweep` are still to come.
+//! directories ([`scenario`]). Finger touches, drawings and `piano sweep` are still to
+//! come.
 //!
 #![warn(missing_docs)]
 

@@ -68,11 +68,23 @@ fn simulate_scenario(
     path: &std::path::Path,
     out: &std::path::Path,
 ) -> Result<(), String> {
-    use piano_action::scenario::{Scenario, write_run_dir};
+    use piano_action::scenario::{InputSpec, Scenario, write_pendulum_dir, write_run_dir};
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let scenario =
         Scenario::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
+        let swing = piano_action::pendulum::swing(params, release_angle_deg, scenario.duration_s)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        write_pendulum_dir(out, &scenario, params, &swing).map_err(|e| e.to_string())?;
+        println!(
+            "hammer swing: {} turning points in {} s",
+            swing.turns.len(),
+            scenario.duration_s
+        );
+        println!("run directory: {}", out.display());
+        return Ok(());
+    }
     let kind = scenario
         .model_kind()
         .map_err(|e| format!("{}: {e}", path.display()))?;

@@ -30,6 +30,12 @@ pub enum InputSpec {
         /// Drop height (m).
         height_m: f64,
     },
+    /// The hammer alone on its flange released from `release_angle_deg` off hanging (the
+    /// pendulum or swing test); `model` is not used.
+    Pendulum {
+        /// Release angle from the hanging position (degrees).
+        release_angle_deg: f64,
+    },
     /// Prescribed key-front depth, `points = [[time_s, depth_mm], ...]`, piecewise linear.
     Motion {
         /// `[time_s, depth_mm]` points.
@@ -88,6 +94,14 @@ impl Scenario {
         let input = match &self.input {
             &InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
             &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
+            InputSpec::Pendulum { .. } => {
+                return Err(PianoError::Params {
+                    field: "input.kind".into(),
+                    message: "a pendulum scenario has no keystroke: run it with `swing` and \
+                              `write_pendulum_dir`"
+                        .into(),
+                });
+            }
             InputSpec::Motion { points } => Input::Motion {
                 points: points.iter().map(|p| (p[0], p[1])).collect(),
             },
@@ -183,6 +197,73 @@ pub fn write_run_dir(
         "key_bottom_time_s": num(run.key_bottom_time_s),
         "check_time_s": num(run.check_time_s),
         "events": events,
+    });
+    std::fs::write(dir.join("summary.json"), json(&summary)).map_err(|e| io(e, "summary.json"))?;
+    Ok(())
+}
+
+/// Writes the run directory of a pendulum scenario: `run.json`, `events.json` (the turning
+/// points) and `summary.json` (no strikes; the turning points, the period and what the
+/// hammer's inertia and centre of mass predict for small swings).
+pub fn write_pendulum_dir(
+    dir: &Path,
+    scenario: &Scenario,
+    params: &ActionParams,
+    swing: &crate::pendulum::Swing,
+) -> Result<()> {
+    let io = |e: std::io::Error, what: &str| PianoError::Params {
+        field: String::new(),
+        message: format!("cannot write {}: {e}", dir.join(what).display()),
+    };
+    std::fs::create_dir_all(dir).map_err(|e| io(e, ""))?;
+    let json = |v: &serde_json::Value| serde_json::to_string_pretty(v).unwrap_or_default();
+    let run_json = serde_json::json!({
+        "scenario": serde_json::to_value(scenario).unwrap_or_default(),
+        "params": serde_json::to_value(params).unwrap_or_default(),
+        "version": env!("CARGO_PKG_VERSION"),
+    });
+    std::fs::write(dir.join("run.json"), json(&run_json)).map_err(|e| io(e, "run.json"))?;
+    let events: Vec<serde_json::Value> = swing
+        .turns
+        .iter()
+        .map(|t| serde_json::json!({"name": "turn", "time_s": t.time_s}))
+        .collect();
+    std::fs::write(
+        dir.join("events.json"),
+        json(&serde_json::Value::from(events.clone())),
+    )
+    .map_err(|e| io(e, "events.json"))?;
+    let turns: Vec<serde_json::Value> = swing
+        .turns
+        .iter()
+        .map(|t| serde_json::json!({"time_s": t.time_s, "angle_deg": t.angle_rad.to_degrees()}))
+        .collect();
+    // Two turns per period.
+    let period = (swing.turns.len() >= 2).then(|| {
+        let (first, last) = (
+            swing.turns[0].time_s,
+            swing.turns[swing.turns.len() - 1].time_s,
+        );
+        2.0 * (last - first) / (swing.turns.len() - 1) as f64
+    });
+    let m = params.hammer.mass_g * 1e-3;
+    let small = 2.0
+        * std::f64::consts::PI
+        * (swing.inertia_pin_kg_m2 / (m * 9.81 * swing.com_distance_m)).sqrt();
+    let summary = serde_json::json!({
+        "model": "pendulum",
+        "strikes": [],
+        "let_off_time_s": null,
+        "key_bottom_time_s": null,
+        "check_time_s": null,
+        "events": events,
+        "pendulum": {
+            "turns": turns,
+            "period_s": num(period),
+            "small_amplitude_period_s": small,
+            "com_distance_m": swing.com_distance_m,
+            "inertia_pin_kg_m2": swing.inertia_pin_kg_m2,
+        },
     });
     std::fs::write(dir.join("summary.json"), json(&summary)).map_err(|e| io(e, "summary.json"))?;
     Ok(())
