@@ -116,6 +116,37 @@ impl Scenario {
     }
 }
 
+/// Writes `text` to `dir/name`; the error names the file.
+fn write_file(dir: &Path, name: &str, text: &str) -> Result<()> {
+    std::fs::write(dir.join(name), text).map_err(|e| PianoError::Params {
+        field: String::new(),
+        message: format!("cannot write {}: {e}", dir.join(name).display()),
+    })
+}
+
+/// Writes `value` as pretty JSON to `dir/name`.
+fn write_json(dir: &Path, name: &str, value: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| PianoError::Params {
+        field: String::new(),
+        message: format!("cannot encode {name}: {e}"),
+    })?;
+    write_file(dir, name, &text)
+}
+
+/// Creates the run directory and writes `run.json` (scenario, parameters, version).
+fn start_run_dir(dir: &Path, scenario: &Scenario, params: &ActionParams) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| PianoError::Params {
+        field: String::new(),
+        message: format!("cannot create {}: {e}", dir.display()),
+    })?;
+    let run_json = serde_json::json!({
+        "scenario": serde_json::to_value(scenario).unwrap_or_default(),
+        "params": serde_json::to_value(params).unwrap_or_default(),
+        "version": env!("CARGO_PKG_VERSION"),
+    });
+    write_json(dir, "run.json", &run_json)
+}
+
 fn num(x: Option<f64>) -> serde_json::Value {
     x.map_or(serde_json::Value::Null, serde_json::Value::from)
 }
@@ -130,18 +161,7 @@ pub fn write_run_dir(
     run: &Run,
     names: &[String],
 ) -> Result<()> {
-    let io = |e: std::io::Error, what: &str| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot write {}: {e}", dir.join(what).display()),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| io(e, ""))?;
-    let json = |v: &serde_json::Value| serde_json::to_string_pretty(v).unwrap_or_default();
-    let run_json = serde_json::json!({
-        "scenario": serde_json::to_value(scenario).unwrap_or_default(),
-        "params": serde_json::to_value(params).unwrap_or_default(),
-        "version": env!("CARGO_PKG_VERSION"),
-    });
-    std::fs::write(dir.join("run.json"), json(&run_json)).map_err(|e| io(e, "run.json"))?;
+    start_run_dir(dir, scenario, params)?;
 
     let sol = &run.solution;
     let nv = names.len();
@@ -167,18 +187,14 @@ pub fn write_run_dir(
         }
         csv.push('\n');
     }
-    std::fs::write(dir.join("trajectory.csv"), csv).map_err(|e| io(e, "trajectory.csv"))?;
+    write_file(dir, "trajectory.csv", &csv)?;
 
     let events: Vec<serde_json::Value> = run
         .events
         .iter()
         .map(|e| serde_json::json!({"name": e.name, "time_s": e.time_s}))
         .collect();
-    std::fs::write(
-        dir.join("events.json"),
-        json(&serde_json::Value::from(events.clone())),
-    )
-    .map_err(|e| io(e, "events.json"))?;
+    write_json(dir, "events.json", &serde_json::Value::from(events.clone()))?;
     let strikes: Vec<serde_json::Value> = run
         .strikes
         .iter()
@@ -198,7 +214,7 @@ pub fn write_run_dir(
         "check_time_s": num(run.check_time_s),
         "events": events,
     });
-    std::fs::write(dir.join("summary.json"), json(&summary)).map_err(|e| io(e, "summary.json"))?;
+    write_json(dir, "summary.json", &summary)?;
     Ok(())
 }
 
@@ -211,28 +227,13 @@ pub fn write_pendulum_dir(
     params: &ActionParams,
     swing: &crate::pendulum::Swing,
 ) -> Result<()> {
-    let io = |e: std::io::Error, what: &str| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot write {}: {e}", dir.join(what).display()),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| io(e, ""))?;
-    let json = |v: &serde_json::Value| serde_json::to_string_pretty(v).unwrap_or_default();
-    let run_json = serde_json::json!({
-        "scenario": serde_json::to_value(scenario).unwrap_or_default(),
-        "params": serde_json::to_value(params).unwrap_or_default(),
-        "version": env!("CARGO_PKG_VERSION"),
-    });
-    std::fs::write(dir.join("run.json"), json(&run_json)).map_err(|e| io(e, "run.json"))?;
+    start_run_dir(dir, scenario, params)?;
     let events: Vec<serde_json::Value> = swing
         .turns
         .iter()
         .map(|t| serde_json::json!({"name": "turn", "time_s": t.time_s}))
         .collect();
-    std::fs::write(
-        dir.join("events.json"),
-        json(&serde_json::Value::from(events.clone())),
-    )
-    .map_err(|e| io(e, "events.json"))?;
+    write_json(dir, "events.json", &serde_json::Value::from(events.clone()))?;
     let turns: Vec<serde_json::Value> = swing
         .turns
         .iter()
@@ -265,6 +266,6 @@ pub fn write_pendulum_dir(
             "inertia_pin_kg_m2": swing.inertia_pin_kg_m2,
         },
     });
-    std::fs::write(dir.join("summary.json"), json(&summary)).map_err(|e| io(e, "summary.json"))?;
+    write_json(dir, "summary.json", &summary)?;
     Ok(())
 }
