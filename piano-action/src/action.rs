@@ -97,14 +97,38 @@ fn circle(c: [f64; 2], r_mm: f64) -> Result<Shape> {
     Ok(Shape::circle(m(c), r_mm * 1e-3)?)
 }
 
-/// A weight resting on (or dropped onto) the key front: a body sliding vertically over the
-/// finger point, touching the key top through a firm pad (the 1 kg experiment).
+/// A body over the key front sliding vertically above the finger point and touching the
+/// key top through a pad: a weight resting on or dropped onto the key (the 1 kg
+/// experiment), or a finger.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Presser {
     /// Its mass (kg).
     pub mass_kg: f64,
     /// Height of its pad above the key top at t = 0 (mm; 0 = resting on it).
     pub height_mm: f64,
+    /// The pad's contact law.
+    pub pad: ContactParams,
+    /// Whether something else carries its weight (a finger, held by the arm): gravity on it
+    /// is balanced by an equal upward force.
+    pub carried: bool,
+}
+
+impl Presser {
+    /// A weight of `mass_kg` with its firm pad (Hunt–Crossley k = 1e7, p = 1.5, e = 0.5
+    /// [D]) `height_mm` above the key top.
+    pub fn weight(mass_kg: f64, height_mm: f64) -> Self {
+        Presser {
+            mass_kg,
+            height_mm,
+            pad: ContactParams {
+                k: 1.0e7,
+                p: 1.5,
+                e: 0.5,
+                mu: 0.0,
+            },
+            carried: false,
+        }
+    }
 }
 
 impl Action {
@@ -489,13 +513,18 @@ impl Action {
             &c.hammer_string,
             &mut system,
         )?;
-        if presser.is_some() {
-            let pad = ContactParams {
-                k: 1.0e7,
-                p: 1.5,
-                e: 0.5,
-                mu: 0.0,
-            };
+        if let Some(pr) = presser {
+            if pr.carried {
+                let weight = AppliedLoad::force(
+                    &model,
+                    "presser weight carried",
+                    Attachment::on("presser", [0.0, 0.0]),
+                    [0.0, 1.0],
+                    LoadFrame::World,
+                    mbs_core::time_function::Constant(pr.mass_kg * 9.81),
+                )?;
+                system.add_element(weight)?;
+            }
             let kf = [k.finger_mm[0] - kp[0], k.finger_mm[1] - kp[1]];
             add(
                 "presser_key",
@@ -507,7 +536,7 @@ impl Action {
                     )?],
                 ),
                 ContactSide::on("presser", vec![circle([0.0, 0.0], PAD_RADIUS_MM)?]),
-                &pad,
+                &pr.pad,
                 &mut system,
             )?;
         }

@@ -27,4 +27,4 @@ pub mod touchweight;
 pub use action::{Action, ModelKind, Presser};
 pub use error::{PianoError, Result};
 pub use params::ActionParams;
-pub use simulate::{Input, PianoEvent, Run, Strike, simulate};
+pub use simulate::{Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate};

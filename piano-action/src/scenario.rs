@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::action::ModelKind;
 use crate::error::{PianoError, Result};
 use crate::params::ActionParams;
-use crate::simulate::{Input, Run, simulate};
+use crate::simulate::{Finger, Input, Run, TouchStyle, simulate};
 
 /// The input of a scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -36,11 +36,111 @@ pub enum InputSpec {
         /// Release angle from the hanging position (degrees).
         release_angle_deg: f64,
     },
+    /// A finger touch: `style = "pressed"` with `peak_force_n`, or `style = "struck"` with
+    /// `finger_speed_m_s`; the finger's `finger_mass_g`, `rise_s` and `arm_damping_n_s_m`
+    /// default to [`Finger::default`].
+    Touch {
+        /// `"pressed"` or `"struck"`.
+        style: TouchStyleName,
+        /// Peak force of a pressed touch (N).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        peak_force_n: Option<f64>,
+        /// Arrival speed of a struck finger (m/s).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        finger_speed_m_s: Option<f64>,
+        /// Effective finger mass (g).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        finger_mass_g: Option<f64>,
+        /// Rise time of a pressed touch's force (s).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        rise_s: Option<f64>,
+        /// Arm coupling of a struck touch (N·s/m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        arm_damping_n_s_m: Option<f64>,
+    },
     /// Prescribed key-front depth, `points = [[time_s, depth_mm], ...]`, piecewise linear.
     Motion {
         /// `[time_s, depth_mm]` points.
         points: Vec<[f64; 2]>,
     },
+}
+
+/// The two touches of Goebl, Bresin & Galembo (2005).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TouchStyleName {
+    /// The finger rests on the key and pushes.
+    Pressed,
+    /// The finger arrives with a speed.
+    Struck,
+}
+
+impl InputSpec {
+    /// The simulation input this spec describes; a missing or misplaced field is named.
+    pub fn to_input(&self) -> Result<Input> {
+        Ok(match self {
+            &InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
+            &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
+            InputSpec::Pendulum { .. } => {
+                return Err(PianoError::Params {
+                    field: "input.kind".into(),
+                    message: "a pendulum scenario has no keystroke: run it with `swing` and \
+                              `write_pendulum_dir`"
+                        .into(),
+                });
+            }
+            InputSpec::Motion { points } => Input::Motion {
+                points: points.iter().map(|p| (p[0], p[1])).collect(),
+            },
+            &InputSpec::Touch {
+                style,
+                peak_force_n,
+                finger_speed_m_s,
+                finger_mass_g,
+                rise_s,
+                arm_damping_n_s_m,
+            } => {
+                let missing = |field: &str, style: &str| PianoError::Params {
+                    field: format!("input.{field}"),
+                    message: format!("a {style} touch needs {field}"),
+                };
+                let misplaced = |field: &str, style: &str| PianoError::Params {
+                    field: format!("input.{field}"),
+                    message: format!("does not apply to a {style} touch"),
+                };
+                let style = match style {
+                    TouchStyleName::Pressed => {
+                        if finger_speed_m_s.is_some() {
+                            return Err(misplaced("finger_speed_m_s", "pressed"));
+                        }
+                        TouchStyle::Pressed {
+                            peak_force_n: peak_force_n
+                                .ok_or_else(|| missing("peak_force_n", "pressed"))?,
+                        }
+                    }
+                    TouchStyleName::Struck => {
+                        if peak_force_n.is_some() {
+                            return Err(misplaced("peak_force_n", "struck"));
+                        }
+                        TouchStyle::Struck {
+                            finger_speed_m_s: finger_speed_m_s
+                                .ok_or_else(|| missing("finger_speed_m_s", "struck"))?,
+                        }
+                    }
+                };
+                let d = Finger::default();
+                Input::Touch {
+                    style,
+                    finger: Finger {
+                        mass_g: finger_mass_g.unwrap_or(d.mass_g),
+                        rise_s: rise_s.unwrap_or(d.rise_s),
+                        arm_damping_n_s_m: arm_damping_n_s_m.unwrap_or(d.arm_damping_n_s_m),
+                        pad: d.pad,
+                    },
+                }
+            }
+        })
+    }
 }
 
 /// A scenario file.
@@ -91,21 +191,7 @@ impl Scenario {
 
     /// Runs the scenario.
     pub fn run(&self, params: &ActionParams) -> Result<Run> {
-        let input = match &self.input {
-            &InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
-            &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
-            InputSpec::Pendulum { .. } => {
-                return Err(PianoError::Params {
-                    field: "input.kind".into(),
-                    message: "a pendulum scenario has no keystroke: run it with `swing` and \
-                              `write_pendulum_dir`"
-                        .into(),
-                });
-            }
-            InputSpec::Motion { points } => Input::Motion {
-                points: points.iter().map(|p| (p[0], p[1])).collect(),
-            },
-        };
+        let input = self.input.to_input()?;
         simulate(
             params,
             self.model_kind()?,
@@ -209,8 +295,15 @@ pub fn write_run_dir(
     let summary = serde_json::json!({
         "model": run.kind.name(),
         "strikes": strikes,
+        "key_start_time_s": num(run.key_start_time_s),
+        "travel_time_s": num(run.travel_time_s),
         "let_off_time_s": num(run.let_off_time_s),
         "key_bottom_time_s": num(run.key_bottom_time_s),
+        "key_bottom_minus_string_contact_s": num(
+            run.key_bottom_time_s
+                .zip(run.strikes.first())
+                .map(|(k, s)| k - s.time_s)
+        ),
         "check_time_s": num(run.check_time_s),
         "events": events,
     });

@@ -4,9 +4,11 @@
 use mbs_core::time_function::{Drive, DriveState, PiecewiseLinear};
 use mbs_integrators::Solution;
 
-use crate::action::{Action, ModelKind};
+use mbs_core::elements::{AppliedLoad, Attachment, JointSpringDamper, LoadFrame, SpringLaw};
+
+use crate::action::{Action, ModelKind, Presser};
 use crate::error::{PianoError, Result};
-use crate::params::ActionParams;
+use crate::params::{ActionParams, ContactParams};
 
 /// What drives the key.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +38,69 @@ pub enum Input {
         /// Drop height (m).
         height_m: f64,
     },
+    /// A finger playing the key: its pad touches the key top at the finger point.
+    Touch {
+        /// Pressed (resting, force building up) or struck (arriving with a speed).
+        style: TouchStyle,
+        /// The finger's mass, pad and arm.
+        finger: Finger,
+    },
+}
+
+/// How the finger plays the key (Goebl, Bresin & Galembo 2005: pressed and struck touch).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TouchStyle {
+    /// The finger rests on the key and its force builds up linearly to `peak_force_n` over
+    /// [`Finger::rise_s`], then holds.
+    Pressed {
+        /// Force reached at the end of the rise (N).
+        peak_force_n: f64,
+    },
+    /// The finger arrives at `finger_speed_m_s`, its pad [`STRUCK_START_MM`] above the key
+    /// top at t = 0; the arm keeps pushing toward that speed through a viscous coupling
+    /// ([`Finger::arm_damping_n_s_m`]), so it pushes harder the more the key resists and
+    /// holds `arm_damping × speed` on the bottomed key.
+    Struck {
+        /// Finger speed on arrival (m/s, downward).
+        finger_speed_m_s: f64,
+    },
+}
+
+/// Height of a struck finger's pad above the key top at t = 0 (mm).
+pub const STRUCK_START_MM: f64 = 0.5;
+
+/// The finger of a touch. Its weight is carried by the arm: only the touch force and its
+/// inertia act on the key.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Finger {
+    /// Effective mass of the fingertip and the part of the hand moving with it (g).
+    pub mass_g: f64,
+    /// Rise time of a pressed touch's force (s).
+    pub rise_s: f64,
+    /// Viscous coupling of the arm driving a struck finger (N·s/m).
+    pub arm_damping_n_s_m: f64,
+    /// Pulp of the fingertip against the key top (Hunt–Crossley, soft and lossy).
+    pub pad: ContactParams,
+}
+
+impl Default for Finger {
+    /// A fingertip derived for this model [D]: 20 g effective mass, the pressed force
+    /// rising over 30 ms, an arm coupling of 20 N·s/m (a 1 m/s finger holds 20 N on the
+    /// bottomed key, inside the 8-50 N staccato peaks of Kinoshita et al. 2007), and a pulp
+    /// stiffening as `k δ²` with k = 2e6 N/m² (2 N at 1 mm, 50 N at 5 mm), restitution 0.2.
+    fn default() -> Self {
+        Finger {
+            mass_g: 20.0,
+            rise_s: 0.03,
+            arm_damping_n_s_m: 20.0,
+            pad: ContactParams {
+                k: 2.0e6,
+                p: 2.0,
+                e: 0.2,
+                mu: 0.0,
+            },
+        }
+    }
 }
 
 impl Input {
@@ -70,6 +135,46 @@ impl Input {
                         field: "input.height_m".into(),
                         message: format!("must be 0 to 0.5 m, got {height_m}"),
                     });
+                }
+                Ok(())
+            }
+            Input::Touch { style, finger } => {
+                let bad = |field: &str, message: String| PianoError::Params {
+                    field: format!("input.{field}"),
+                    message,
+                };
+                match style {
+                    TouchStyle::Pressed { peak_force_n } => {
+                        if !(peak_force_n.is_finite() && (0.0..=200.0).contains(&peak_force_n)) {
+                            return Err(bad(
+                                "peak_force_n",
+                                format!("must be a force of 0 to 200 N, got {peak_force_n}"),
+                            ));
+                        }
+                    }
+                    TouchStyle::Struck { finger_speed_m_s } => {
+                        if !(finger_speed_m_s.is_finite()
+                            && finger_speed_m_s > 0.0
+                            && finger_speed_m_s <= 10.0)
+                        {
+                            return Err(bad(
+                                "finger_speed_m_s",
+                                format!(
+                                    "must be a speed above 0 and up to 10 m/s, got {finger_speed_m_s}"
+                                ),
+                            ));
+                        }
+                    }
+                }
+                let positive = [
+                    ("finger_mass_g", finger.mass_g),
+                    ("rise_s", finger.rise_s),
+                    ("arm_damping_n_s_m", finger.arm_damping_n_s_m),
+                ];
+                for (field, v) in positive {
+                    if !(v.is_finite() && v > 0.0) {
+                        return Err(bad(field, format!("must be positive, got {v}")));
+                    }
                 }
                 Ok(())
             }
@@ -111,7 +216,7 @@ pub fn key_angle_for_depth(params: &ActionParams, depth_mm: f64) -> f64 {
     let mut q = depth_mm / (fx * fx + fy * fy).sqrt();
     for _ in 0..6 {
         let (s, c) = q.sin_cos();
-        let f = fy - (fx * s + fy * c) - depth_mm;
+        let f = key_depth_mm(params, q) - depth_mm;
         let df = -(fx * c - fy * s);
         q -= f / df;
     }
@@ -235,6 +340,11 @@ pub struct Run {
     pub events: Vec<PianoEvent>,
     /// The blows.
     pub strikes: Vec<Strike>,
+    /// When the key front has first gone [`KEY_START_MM`] down (s).
+    pub key_start_time_s: Option<f64>,
+    /// From key start to the first string contact (s): the travel time of Askenfelt &
+    /// Jansson and Goebl et al.
+    pub travel_time_s: Option<f64>,
     /// First let-off (jack toe on the button), if any (s).
     pub let_off_time_s: Option<f64>,
     /// First key bottom (key on the front-rail punching) (s).
@@ -246,8 +356,53 @@ pub struct Run {
     pub key_drive_force_n: Vec<f64>,
 }
 
+/// Key-front depth (mm) that marks the key's start: the finger has begun to move it.
+pub const KEY_START_MM: f64 = 0.1;
+
+/// The first time the key front is [`KEY_START_MM`] down: from the prescribed table under a
+/// motion input, otherwise interpolated on the output grid.
+fn key_start_time(
+    params: &ActionParams,
+    input: &Input,
+    solution: &Solution,
+    key: usize,
+) -> Option<f64> {
+    if let Input::Motion { points } = input {
+        let depth = BlendedLinear::new(points, 5e-3);
+        let (t0, t1) = (points[0].0 - 5e-3, points[points.len() - 1].0 + 5e-3);
+        let n = ((t1 - t0) / 1e-5).ceil() as usize;
+        return (0..=n)
+            .map(|i| t0 + i as f64 * 1e-5)
+            .find(|&t| depth.eval(t).q >= KEY_START_MM)
+            .map(|t| t.max(0.0));
+    }
+    let depth_at = |i: usize| key_depth_mm(params, solution.state(i)[key]);
+    let mut before = (solution.t[0], depth_at(0));
+    if before.1 >= KEY_START_MM {
+        return Some(before.0);
+    }
+    for i in 1..solution.len() {
+        let now = (solution.t[i], depth_at(i));
+        if now.1 >= KEY_START_MM {
+            let u = (KEY_START_MM - before.1) / (now.1 - before.1);
+            return Some(before.0 + u * (now.0 - before.0));
+        }
+        before = now;
+    }
+    None
+}
+
+/// Key-front depth (mm, down positive) at key angle `q`.
+pub fn key_depth_mm(params: &ActionParams, q: f64) -> f64 {
+    let fx = params.key.finger_mm[0] - params.key.pivot_mm[0];
+    let fy = params.key.finger_mm[1] - params.key.pivot_mm[1];
+    let (s, c) = q.sin_cos();
+    fy - (fx * s + fy * c)
+}
+
 /// Contacts whose onset and release are piano events.
-const EVENT_NAMES: [(&str, &str, &str); 5] = [
+const EVENT_NAMES: [(&str, &str, &str); 6] = [
+    ("presser_key", "finger_key", "finger_key_release"),
     ("let_off_button", "let_off", "let_off_release"),
     (
         "hammer_string",
@@ -275,16 +430,48 @@ pub fn simulate(
         });
     }
     let presser = match *input {
-        Input::MassDrop { mass_kg, height_m } => Some(crate::action::Presser {
-            mass_kg,
-            height_mm: height_m * 1e3,
+        Input::MassDrop { mass_kg, height_m } => Some(Presser::weight(mass_kg, height_m * 1e3)),
+        Input::Touch { style, finger } => Some(Presser {
+            mass_kg: finger.mass_g * 1e-3,
+            height_mm: match style {
+                TouchStyle::Pressed { .. } => 0.0,
+                TouchStyle::Struck { .. } => STRUCK_START_MM,
+            },
+            pad: finger.pad,
+            carried: true,
         }),
         _ => None,
     };
     let mut action = Action::build_with(params, kind, presser)?;
     let model = action.system.model().clone();
+    let nv = model.nv();
+    let mut v0 = vec![0.0; nv];
     match *input {
         Input::MassDrop { .. } => {}
+        Input::Touch { style, finger } => match style {
+            TouchStyle::Pressed { peak_force_n } => {
+                let push = AppliedLoad::force(
+                    &model,
+                    "finger",
+                    Attachment::on("presser", [0.0, 0.0]),
+                    [0.0, -1.0],
+                    LoadFrame::World,
+                    PiecewiseLinear::new(vec![(0.0, 0.0), (finger.rise_s, peak_force_n)])?,
+                )?;
+                action.system.add_element(push)?;
+            }
+            TouchStyle::Struck { finger_speed_m_s } => {
+                // τ = −c (v + v₀): no force while the finger moves at v₀ (downward).
+                let c = finger.arm_damping_n_s_m;
+                let arm = SpringLaw::new(0.0, 0.0)
+                    .with_damping(c)
+                    .with_preload(-c * finger_speed_m_s);
+                action
+                    .system
+                    .add_element(JointSpringDamper::new(&model, "presser", arm)?.named("arm"))?;
+                v0[model.coordinate_id("presser")?] = -finger_speed_m_s;
+            }
+        },
         Input::Force { force_n, release_s } => {
             let table = match release_s {
                 None => vec![(0.0, force_n)],
@@ -302,10 +489,7 @@ pub fn simulate(
                 .prescribe("key", BlendedLinear::new(&table, 5e-3))?;
         }
     }
-    let nv = model.nv();
-    let x0 = action
-        .system
-        .initial_state(0.0, &vec![0.0; nv], &vec![0.0; nv])?;
+    let x0 = action.system.initial_state(0.0, &vec![0.0; nv], &v0)?;
     let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
     let mut key_drive_force_n = Vec::new();
     if matches!(input, Input::Motion { .. }) {
@@ -330,17 +514,51 @@ pub fn simulate(
         let s = params.hammer.strike_body_mm;
         (s[0] * s[0] + s[1] * s[1]).sqrt() * 1e-3
     };
+    let key_start_time_s = key_start_time(params, input, &solution, model.coordinate_id("key")?);
     let mut events = Vec::new();
+    if let Some(t) = key_start_time_s {
+        events.push(PianoEvent {
+            name: "key_start",
+            time_s: t,
+        });
+    }
     let mut strikes: Vec<Strike> = Vec::new();
+    // The jack is reset when it comes back to its stop under the knuckle after a let-off,
+    // once the key has begun to rise from the front rail.
+    let jack_limit = "joint limit 'jack' #0";
+    let jack = model.coordinate_id("jack").ok();
+    let (mut escaped, mut key_rising) = (false, false);
     for ev in &solution.events {
+        if ev.name == jack_limit
+            && let Some(j) = jack
+            && ev.state[j] < params.jack.stop_angle_rad
+            && escaped
+            && key_rising
+        {
+            events.push(PianoEvent {
+                name: "jack_reset",
+                time_s: ev.time,
+            });
+            (escaped, key_rising) = (false, false);
+        }
         for (contact, on, off) in EVENT_NAMES {
             if ev.name == format!("contact '{contact}' #0") {
                 // The event state is just past the crossing: a negative gap is an onset.
                 let onset = action.gap(contact, ev.time, &ev.state)? < 0.0;
+                let (on, off) = match input {
+                    Input::MassDrop { .. } if contact == "presser_key" => ("mass_key", "mass_lift"),
+                    _ => (on, off),
+                };
+                let name = if onset { on } else { off };
                 events.push(PianoEvent {
-                    name: if onset { on } else { off },
+                    name,
                     time_s: ev.time,
                 });
+                match name {
+                    "let_off" => (escaped, key_rising) = (true, false),
+                    "key_lift" => key_rising = escaped,
+                    _ => {}
+                }
                 if contact == "hammer_string" {
                     if onset {
                         strikes.push(Strike {
@@ -357,14 +575,21 @@ pub fn simulate(
             }
         }
     }
+    events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let first = |name: &str| events.iter().find(|e| e.name == name).map(|e| e.time_s);
     let first_strike = strikes.first().map(|s| s.time_s);
     let check_time_s = events
         .iter()
         .find(|e| e.name == "check_catch" && first_strike.is_some_and(|t| e.time_s > t))
         .map(|e| e.time_s);
+    let travel_time_s = match (key_start_time_s, strikes.first()) {
+        (Some(t0), Some(s)) => Some(s.time_s - t0),
+        _ => None,
+    };
     Ok(Run {
         kind,
+        key_start_time_s,
+        travel_time_s,
         let_off_time_s: first("let_off"),
         key_bottom_time_s: first("key_bottom"),
         check_time_s,

@@ -203,3 +203,69 @@ fn a_pendulum_scenario_writes_the_swing_and_its_period() {
     assert!((2..=4).contains(&turns.len()), "{turns:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn simulate_runs_finger_touches_and_names_what_is_missing() {
+    let dir = std::env::temp_dir().join(format!("piano-touch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = dir.join("touch.toml");
+    let run = |text: &str, out: &str| {
+        std::fs::write(&scenario, text).unwrap();
+        piano(&[
+            "simulate",
+            scenario.to_str().unwrap(),
+            "--out",
+            dir.join(out).to_str().unwrap(),
+        ])
+    };
+    let summary = |out: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("summary.json")).unwrap())
+            .unwrap()
+    };
+    let head = "model = \"double\"\nduration_s = 0.1\n[input]\nkind = \"touch\"\n";
+    let (ok, _, err) = run(
+        &format!("{head}style = \"struck\"\nfinger_speed_m_s = 0.8\n"),
+        "struck",
+    );
+    assert!(ok, "{err}");
+    let s = summary("struck");
+    let names: Vec<&str> = s["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names[..2], ["finger_key", "key_start"], "{names:?}");
+    let travel = s["travel_time_s"].as_f64().unwrap();
+    let strike = s["strikes"][0]["time_s"].as_f64().unwrap();
+    let start = s["key_start_time_s"].as_f64().unwrap();
+    assert!((travel - (strike - start)).abs() < 1e-12);
+    assert!(s["key_bottom_minus_string_contact_s"].as_f64().is_some());
+    // A heavier finger, pressed.
+    let (ok, _, err) = run(
+        &format!("{head}style = \"pressed\"\npeak_force_n = 10.0\nfinger_mass_g = 40.0\n"),
+        "pressed",
+    );
+    assert!(ok, "{err}");
+    let v = summary("pressed")["strikes"][0]["hammer_velocity_m_s"]
+        .as_f64()
+        .unwrap();
+    assert!((2.0..6.0).contains(&v), "pressed 10 N gives {v} m/s");
+    // Missing, misplaced and misspelt fields are named.
+    for (body, field) in [
+        ("style = \"struck\"\n", "input.finger_speed_m_s"),
+        (
+            "style = \"pressed\"\npeak_force_n = 2.0\nfinger_speed_m_s = 1.0\n",
+            "input.finger_speed_m_s",
+        ),
+        ("style = \"tapped\"\npeak_force_n = 2.0\n", "input"),
+        (
+            "style = \"pressed\"\npeak_force_n = 2.0\nrise_s = 0.0\n",
+            "input.rise_s",
+        ),
+    ] {
+        let (ok, _, err) = run(&format!("{head}{body}"), "bad");
+        assert!(!ok && err.contains(field), "{body}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
