@@ -596,6 +596,18 @@ impl Action {
         .map_err(|e| crate::PianoError::Simulation(e.to_string()))
     }
 
+    /// The coordinates of `kind` settled at rest with nothing on the key: the layout state
+    /// integrated for 0.3 s (the key drops onto its cloths and the hammer onto its rail,
+    /// and the ringing dies away). Keystrokes start here.
+    pub fn rest_coordinates(params: &ActionParams, kind: ModelKind) -> Result<Vec<f64>> {
+        let action = Action::build(params, kind)?;
+        let x0 = action.layout_state()?;
+        let settled = action.integrate(&x0, 0.3, 2e-3, Some(0.3))?;
+        let nv = action.system.model().nv();
+        let last = settled.len().saturating_sub(1);
+        Ok(settled.state(last)[..nv].to_vec())
+    }
+
     /// The state at rest as laid out: every coordinate zero, at rest, internal states at
     /// their initial values.
     pub fn layout_state(&self) -> Result<Vec<f64>> {

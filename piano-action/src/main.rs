@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use piano_action::{ActionParams, Input, ModelKind, simulate};
+use piano_action::{ActionParams, Finger, Input, ModelKind, TouchStyle, simulate};
 
 /// Grand piano action simulator.
 #[derive(Parser)]
@@ -23,8 +23,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Press the double-escapement action with forces from soft to loud and print a summary
-    /// (the default).
+    /// Play the double-escapement action with pressed and struck touches from soft to loud
+    /// and print a summary (the default).
     Demo,
     /// Run a scenario (TOML: `model`, `duration_s`, `[input]`) and write its run directory
     /// (run.json, trajectory.csv, events.json, summary.json).
@@ -229,37 +229,67 @@ fn ms(t: Option<f64>) -> String {
 }
 
 fn demo(params: &ActionParams) -> Result<(), String> {
-    println!("Double-escapement grand action, constant force on the key front from t = 0.");
-    println!("Times in ms; hammer velocity of the strike point at string contact.\n");
+    println!("Double-escapement grand action played by a finger, soft to loud.");
+    println!("pressed: the finger rests on the key, its force rising to the peak in 30 ms;");
+    println!("struck: the finger lands on the key at the given speed, the arm pushing on.");
+    println!("Times in ms from the key's start (0.1 mm down); hammer speed at the string.\n");
     println!(
-        "{:>9} {:>9} {:>9} {:>9} {:>12} {:>10} {:>9}",
-        "force (N)", "let-off", "key bot.", "strike", "v_ham (m/s)", "contact", "check"
+        "{:>18} {:>8} {:>8} {:>8} {:>11} {:>8} {:>10} {:>7}",
+        "touch", "let-off", "strike", "v (m/s)", "contact", "check", "key bottom", "vs HS"
     );
-    for force_n in [2.0, 4.0, 8.0, 16.0, 32.0] {
+    let touches = [
+        TouchStyle::Pressed { peak_force_n: 1.0 },
+        TouchStyle::Pressed { peak_force_n: 3.0 },
+        TouchStyle::Pressed { peak_force_n: 10.0 },
+        TouchStyle::Pressed { peak_force_n: 40.0 },
+        TouchStyle::Struck {
+            finger_speed_m_s: 0.15,
+        },
+        TouchStyle::Struck {
+            finger_speed_m_s: 0.4,
+        },
+        TouchStyle::Struck {
+            finger_speed_m_s: 0.8,
+        },
+        TouchStyle::Struck {
+            finger_speed_m_s: 1.6,
+        },
+    ];
+    for style in touches {
         let run = simulate(
             params,
             ModelKind::Double,
-            &Input::Force {
-                force_n,
-                release_s: None,
+            &Input::Touch {
+                style,
+                finger: Finger::default(),
             },
-            0.25,
+            0.3,
             1e-3,
         )
         .map_err(|e| e.to_string())?;
+        let label = match style {
+            TouchStyle::Pressed { peak_force_n } => format!("pressed {peak_force_n:.0} N"),
+            TouchStyle::Struck { finger_speed_m_s } => {
+                format!("struck {finger_speed_m_s:.2} m/s")
+            }
+        };
+        let t0 = run.key_start_time_s.unwrap_or(0.0);
+        let from_start = |t: Option<f64>| ms(t.map(|t| t - t0));
         let strike = run.strikes.first();
         println!(
-            "{:>9.1} {:>9} {:>9} {:>9} {:>12} {:>10} {:>9}",
-            force_n,
-            ms(run.let_off_time_s),
-            ms(run.key_bottom_time_s),
-            ms(strike.map(|s| s.time_s)),
+            "{:>18} {:>8} {:>8} {:>8} {:>11} {:>8} {:>10} {:>7}",
+            label,
+            from_start(run.let_off_time_s),
+            from_start(strike.map(|s| s.time_s)),
             strike.map_or("-".into(), |s| format!("{:.2}", s.hammer_velocity_m_s)),
             ms(strike.and_then(|s| s.contact_duration_s)),
-            ms(run.check_time_s),
+            from_start(run.check_time_s),
+            from_start(run.key_bottom_time_s),
+            ms(run.key_bottom_time_s.zip(strike).map(|(k, s)| k - s.time_s)),
         );
     }
-    println!("\n`piano params` writes the parameter file; `--params FILE` loads your own.");
+    println!("\n`vs HS`: key bottom minus string contact (ms). `piano --help` for more;");
+    println!("`piano params` writes the parameter file, `--params FILE` loads your own.");
     Ok(())
 }
 

@@ -23,8 +23,8 @@ pub enum Input {
     },
     /// Prescribed key-front depth: `(time_s, depth_mm)` points, piecewise linear (corners
     /// rounded over at most 5 ms so the key's acceleration stays finite), held before the
-    /// first point and after the last. Depth is measured at the finger point from the
-    /// layout's rest position, positive down. The force the hand needs is in
+    /// first point and after the last. Depth is measured at the finger point from the key's
+    /// rest (where it settles with nothing on it), positive down. The force the hand needs is in
     /// [`Run::key_drive_force_n`].
     Motion {
         /// `(time_s, depth_mm)` points, times increasing.
@@ -340,7 +340,7 @@ pub struct Run {
     pub events: Vec<PianoEvent>,
     /// The blows.
     pub strikes: Vec<Strike>,
-    /// When the key front has first gone [`KEY_START_MM`] down (s).
+    /// When the key front has first gone [`KEY_START_MM`] below its rest (s).
     pub key_start_time_s: Option<f64>,
     /// From key start to the first string contact (s): the travel time of Askenfelt &
     /// Jansson and Goebl et al.
@@ -356,16 +356,18 @@ pub struct Run {
     pub key_drive_force_n: Vec<f64>,
 }
 
-/// Key-front depth (mm) that marks the key's start: the finger has begun to move it.
+/// Key-front depth below its rest (mm) that marks the key's start: the finger has begun to
+/// move it.
 pub const KEY_START_MM: f64 = 0.1;
 
-/// The first time the key front is [`KEY_START_MM`] down: from the prescribed table under a
+/// The first time the key front is [`KEY_START_MM`] below its rest: from the prescribed table under a
 /// motion input, otherwise interpolated on the output grid.
 fn key_start_time(
     params: &ActionParams,
     input: &Input,
     solution: &Solution,
     key: usize,
+    rest_depth_mm: f64,
 ) -> Option<f64> {
     if let Input::Motion { points } = input {
         let depth = BlendedLinear::new(points, 5e-3);
@@ -376,7 +378,7 @@ fn key_start_time(
             .find(|&t| depth.eval(t).q >= KEY_START_MM)
             .map(|t| t.max(0.0));
     }
-    let depth_at = |i: usize| key_depth_mm(params, solution.state(i)[key]);
+    let depth_at = |i: usize| key_depth_mm(params, solution.state(i)[key]) - rest_depth_mm;
     let mut before = (solution.t[0], depth_at(0));
     if before.1 >= KEY_START_MM {
         return Some(before.0);
@@ -442,9 +444,15 @@ pub fn simulate(
         }),
         _ => None,
     };
+    // Start from the action settled at rest (the presser, if any, last, with its pad where
+    // the layout put it relative to the key top).
+    let rest = Action::rest_coordinates(params, kind)?;
+    let rest_depth_mm = key_depth_mm(params, rest[0]);
     let mut action = Action::build_with(params, kind, presser)?;
     let model = action.system.model().clone();
     let nv = model.nv();
+    let mut q0 = rest.clone();
+    q0.resize(nv, -rest_depth_mm * 1e-3);
     let mut v0 = vec![0.0; nv];
     match *input {
         Input::MassDrop { .. } => {}
@@ -482,14 +490,14 @@ pub fn simulate(
         Input::Motion { ref points } => {
             let table: Vec<(f64, f64)> = points
                 .iter()
-                .map(|&(t, d)| (t, key_angle_for_depth(params, d)))
+                .map(|&(t, d)| (t, key_angle_for_depth(params, d + rest_depth_mm)))
                 .collect();
             action
                 .system
                 .prescribe("key", BlendedLinear::new(&table, 5e-3))?;
         }
     }
-    let x0 = action.system.initial_state(0.0, &vec![0.0; nv], &v0)?;
+    let x0 = action.system.initial_state(0.0, &q0, &v0)?;
     let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
     let mut key_drive_force_n = Vec::new();
     if matches!(input, Input::Motion { .. }) {
@@ -514,7 +522,13 @@ pub fn simulate(
         let s = params.hammer.strike_body_mm;
         (s[0] * s[0] + s[1] * s[1]).sqrt() * 1e-3
     };
-    let key_start_time_s = key_start_time(params, input, &solution, model.coordinate_id("key")?);
+    let key_start_time_s = key_start_time(
+        params,
+        input,
+        &solution,
+        model.coordinate_id("key")?,
+        rest_depth_mm,
+    );
     let mut events = Vec::new();
     if let Some(t) = key_start_time_s {
         events.push(PianoEvent {

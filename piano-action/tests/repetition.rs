@@ -49,8 +49,27 @@ fn half_release_repeats_on_the_double_escapement_only() {
     assert_eq!(d.len(), 2, "double: {d:?}");
     assert!(d[1] > 0.35, "second blow from the second press: {d:?}");
     assert!(double.strikes[1].hammer_velocity_m_s > 0.5);
+    let resets = |run: &piano_action::Run| -> Vec<f64> {
+        run.events
+            .iter()
+            .filter(|e| e.name == "jack_reset")
+            .map(|e| e.time_s)
+            .collect()
+    };
+    // The jack is back under the knuckle after the key has begun to rise (0.2 s) and before
+    // the second press ends (0.39 s).
+    let jr = resets(&double);
+    assert!(
+        jr.len() == 1 && jr[0] > 0.2 && jr[0] < 0.39 && jr[0] < d[1],
+        "double jack resets {jr:?}"
+    );
     // Without the lever the jack cannot get back under the knuckle from half-way.
     assert_eq!(s.len(), 1, "single: {s:?}");
+    assert!(
+        resets(&single).is_empty(),
+        "single jack resets {:?}",
+        resets(&single)
+    );
 }
 
 #[test]
@@ -60,6 +79,12 @@ fn full_release_repeats_on_both_escapement_actions() {
         let t = strike_times(&run);
         println!("{kind:?} {t:?}");
         assert_eq!(t.len(), 2, "{kind:?}: {t:?}");
+        let reset = run.events.iter().find(|e| e.name == "jack_reset");
+        assert!(
+            reset.is_some_and(|e| e.time_s > 0.2 && e.time_s < t[1]),
+            "{kind:?}: the jack resets between the blows: {:?}",
+            run.events
+        );
         assert!(t[1] > 0.35, "{kind:?}: {t:?}");
     }
 }
