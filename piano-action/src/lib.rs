@@ -22,6 +22,7 @@ pub mod pendulum;
 pub mod regulation;
 pub mod scenario;
 pub mod simulate;
+pub mod sweep;
 pub mod touchweight;
 
 pub use action::{Action, ModelKind, Presser};

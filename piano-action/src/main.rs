@@ -51,6 +51,38 @@ enum Command {
         #[arg(long)]
         write: Option<std::path::PathBuf>,
     },
+    /// Play one keystroke per level, in parallel on all cores, and write one CSV row per
+    /// run (hammer speed, string contact, travel time, key bottom, check, ...).
+    Sweep {
+        /// What to vary: `force` (constant key-front force, N), `pressed` (peak force of a
+        /// pressed touch, N) or `struck` (finger speed, m/s).
+        #[arg(long, default_value = "struck")]
+        touch: String,
+        /// First level (default: 1 N, 0.7 N or 0.08 m/s).
+        #[arg(long)]
+        from: Option<f64>,
+        /// Last level (default: 40 N, 50 N or 2 m/s).
+        #[arg(long)]
+        to: Option<f64>,
+        /// Number of runs.
+        #[arg(long, default_value_t = 100)]
+        runs: usize,
+        /// Space the levels evenly rather than on a log scale.
+        #[arg(long)]
+        linear: bool,
+        /// Which model.
+        #[arg(long, default_value = "double")]
+        model: String,
+        /// Simulated time per run (s).
+        #[arg(long, default_value_t = 0.3)]
+        duration: f64,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// The CSV file to write (refuses to overwrite a file).
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
     /// from a slow simulated key descent and ascent.
     Touchweight {
@@ -105,6 +137,95 @@ fn simulate_scenario(
         );
     }
     println!("run directory: {}", out.display());
+    Ok(())
+}
+
+/// The options of `piano sweep`.
+struct SweepArgs {
+    touch: String,
+    from: Option<f64>,
+    to: Option<f64>,
+    runs: usize,
+    linear: bool,
+    model: String,
+    duration: f64,
+    jobs: Option<usize>,
+    out: std::path::PathBuf,
+}
+
+fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
+    use piano_action::sweep::{SweepKind, csv, levels, sweep};
+    let kind = match a.touch.as_str() {
+        "force" => SweepKind::Force,
+        "pressed" => SweepKind::Pressed,
+        "struck" => SweepKind::Struck,
+        other => {
+            return Err(format!(
+                "--touch: unknown '{other}' (force, pressed or struck)"
+            ));
+        }
+    };
+    let (lo, hi) = match kind {
+        SweepKind::Force => (1.0, 40.0),
+        SweepKind::Pressed => (0.7, 50.0),
+        SweepKind::Struck => (0.08, 2.0),
+    };
+    let model = model_kind(&a.model)?;
+    if !(a.duration.is_finite() && a.duration > 0.0) {
+        return Err(format!("--duration: must be positive, got {}", a.duration));
+    }
+    if a.out.exists() {
+        return Err(format!(
+            "{} exists; remove it or choose another --out",
+            a.out.display()
+        ));
+    }
+    let values = levels(a.from.unwrap_or(lo), a.to.unwrap_or(hi), a.runs, !a.linear)
+        .map_err(|e| e.to_string())?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.jobs.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("cannot start the worker threads: {e}"))?;
+    let bar = indicatif::ProgressBar::new(values.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs, {elapsed} elapsed, about {eta} to go",
+        )
+        .map_err(|e| e.to_string())?,
+    );
+    let start = std::time::Instant::now();
+    let rows = pool.install(|| sweep(params, model, kind, &values, a.duration, &|| bar.inc(1)));
+    bar.finish_and_clear();
+    let wall = start.elapsed().as_secs_f64();
+    std::fs::write(&a.out, csv(kind, &rows))
+        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+    let speeds: Vec<f64> = rows
+        .iter()
+        .filter_map(|r| r.run.as_ref().ok())
+        .filter_map(|r| r.strikes.first().map(|s| s.hammer_velocity_m_s))
+        .collect();
+    let failed = rows.iter().filter(|r| r.run.is_err()).count();
+    println!(
+        "{} {} runs of {} s on {} threads in {wall:.1} s wall ({:.2} s per run)",
+        values.len(),
+        kind.name(),
+        a.duration,
+        pool.current_num_threads(),
+        wall / values.len() as f64
+    );
+    if let (Some(min), Some(max)) = (
+        speeds.iter().copied().reduce(f64::min),
+        speeds.iter().copied().reduce(f64::max),
+    ) {
+        println!(
+            "{} runs struck the string, hammer {min:.2} to {max:.2} m/s",
+            speeds.len()
+        );
+    }
+    if failed > 0 {
+        println!("{failed} runs failed: see the error column");
+    }
+    println!("wrote {}", a.out.display());
     Ok(())
 }
 
@@ -303,6 +424,30 @@ fn main() -> ExitCode {
                 regulate(&params, &model, json, write.as_deref())
             }
             Command::Simulate { scenario, out } => simulate_scenario(&params, &scenario, &out),
+            Command::Sweep {
+                touch,
+                from,
+                to,
+                runs,
+                linear,
+                model,
+                duration,
+                jobs,
+                out,
+            } => sweep(
+                &params,
+                SweepArgs {
+                    touch,
+                    from,
+                    to,
+                    runs,
+                    linear,
+                    model,
+                    duration,
+                    jobs,
+                    out,
+                },
+            ),
             Command::Params => {
                 use std::io::Write;
                 let _ = std::io::stdout()

@@ -269,3 +269,36 @@ fn simulate_runs_finger_touches_and_names_what_is_missing() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn sweep_writes_one_row_per_run_and_keeps_existing_files() {
+    let dir = std::env::temp_dir().join(format!("piano-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("sweep.csv");
+    let args = [
+        "sweep",
+        "--touch",
+        "pressed",
+        "--from",
+        "1",
+        "--to",
+        "30",
+        "--runs",
+        "4",
+        "--duration",
+        "0.2",
+        "--out",
+    ];
+    let (ok, stdout, err) = piano(&[&args[..], &[out.to_str().unwrap()]].concat());
+    assert!(ok, "{err}");
+    assert!(stdout.contains("4 pressed runs"), "{stdout}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(text.lines().count(), 5, "{text}");
+    // A second sweep to the same file is refused and the first file is kept.
+    let (ok, _, err) = piano(&[&args[..], &[out.to_str().unwrap()]].concat());
+    assert!(!ok && err.contains("exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
+    let (ok, _, err) = piano(&["sweep", "--touch", "slapped", "--out", "x.csv"]);
+    assert!(!ok && err.contains("--touch"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,168 @@
+//! Sweeps: one keystroke per touch level, run in parallel (rayon), one row each.
+
+use std::fmt::Write as _;
+
+use rayon::prelude::*;
+
+use crate::action::ModelKind;
+use crate::error::{PianoError, Result};
+use crate::params::ActionParams;
+use crate::simulate::{Finger, Input, Run, TouchStyle, simulate};
+
+/// What a sweep varies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweepKind {
+    /// A constant force on the key front (N).
+    Force,
+    /// The peak force of a pressed touch (N).
+    Pressed,
+    /// The arrival speed of a struck finger (m/s).
+    Struck,
+}
+
+impl SweepKind {
+    /// The name used on the command line and in the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepKind::Force => "force",
+            SweepKind::Pressed => "pressed",
+            SweepKind::Struck => "struck",
+        }
+    }
+
+    /// The unit of the swept value.
+    pub fn unit(self) -> &'static str {
+        match self {
+            SweepKind::Force | SweepKind::Pressed => "N",
+            SweepKind::Struck => "m/s",
+        }
+    }
+
+    /// The input for one value.
+    pub fn input(self, value: f64) -> Input {
+        match self {
+            SweepKind::Force => Input::Force {
+                force_n: value,
+                release_s: None,
+            },
+            SweepKind::Pressed => Input::Touch {
+                style: TouchStyle::Pressed {
+                    peak_force_n: value,
+                },
+                finger: Finger::default(),
+            },
+            SweepKind::Struck => Input::Touch {
+                style: TouchStyle::Struck {
+                    finger_speed_m_s: value,
+                },
+                finger: Finger::default(),
+            },
+        }
+    }
+}
+
+/// `n` values from `from` to `to`, evenly spaced on a log scale (both must be positive) or
+/// a linear one.
+pub fn levels(from: f64, to: f64, n: usize, log: bool) -> Result<Vec<f64>> {
+    let bad = |message: String| PianoError::Params {
+        field: "sweep".into(),
+        message,
+    };
+    if !(from.is_finite() && to.is_finite()) || n == 0 {
+        return Err(bad(format!(
+            "needs finite bounds and at least one run, got {from}..{to}, {n} runs"
+        )));
+    }
+    if log && !(from > 0.0 && to > 0.0) {
+        return Err(bad(format!(
+            "a log sweep needs positive bounds, got {from}..{to}"
+        )));
+    }
+    Ok((0..n)
+        .map(|i| {
+            let u = if n == 1 {
+                0.0
+            } else {
+                i as f64 / (n - 1) as f64
+            };
+            if log {
+                (from.ln() + u * (to.ln() - from.ln())).exp()
+            } else {
+                from + u * (to - from)
+            }
+        })
+        .collect())
+}
+
+/// One run of a sweep.
+#[derive(Clone, Debug)]
+pub struct SweepRow {
+    /// The swept value.
+    pub value: f64,
+    /// The run, or why it failed (a failed run does not stop the others).
+    pub run: std::result::Result<Run, String>,
+}
+
+/// Runs `kind` at every value of `values` in parallel on all cores, `duration_s` each,
+/// calling `progress` after each run. Rows come back in the order of `values`.
+pub fn sweep(
+    params: &ActionParams,
+    model: ModelKind,
+    kind: SweepKind,
+    values: &[f64],
+    duration_s: f64,
+    progress: &(dyn Fn() + Sync),
+) -> Vec<SweepRow> {
+    values
+        .par_iter()
+        .map(|&value| {
+            let run = simulate(params, model, &kind.input(value), duration_s, 1e-3)
+                .map_err(|e| e.to_string());
+            progress();
+            SweepRow { value, run }
+        })
+        .collect()
+}
+
+/// The CSV columns of [`csv`].
+pub const CSV_HEADER: &str = "touch,value,unit,hammer_velocity_m_s,string_contact_s,\
+contact_duration_s,key_start_s,travel_time_s,let_off_s,key_bottom_s,\
+key_bottom_minus_string_contact_s,check_s,strikes,error";
+
+/// The rows as CSV (header [`CSV_HEADER`]): times in seconds, empty where a thing did not
+/// happen; `error` says why a run failed.
+pub fn csv(kind: SweepKind, rows: &[SweepRow]) -> String {
+    let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x}"));
+    let mut out = String::from(CSV_HEADER);
+    out.push('\n');
+    for row in rows {
+        let _ = write!(out, "{},{},{},", kind.name(), row.value, kind.unit());
+        match &row.run {
+            Ok(run) => {
+                let s = run.strikes.first();
+                let _ = writeln!(
+                    out,
+                    "{},{},{},{},{},{},{},{},{},{},",
+                    opt(s.map(|s| s.hammer_velocity_m_s)),
+                    opt(s.map(|s| s.time_s)),
+                    opt(s.and_then(|s| s.contact_duration_s)),
+                    opt(run.key_start_time_s),
+                    opt(run.travel_time_s),
+                    opt(run.let_off_time_s),
+                    opt(run.key_bottom_time_s),
+                    opt(run.key_bottom_time_s.zip(s).map(|(k, s)| k - s.time_s)),
+                    opt(run.check_time_s),
+                    run.strikes.len(),
+                );
+            }
+            Err(e) => {
+                let clean: String = e
+                    .chars()
+                    .map(|c| if c == ',' || c == '\n' { ';' } else { c })
+                    .collect();
+                let _ = writeln!(out, ",,,,,,,,,0,{clean}");
+            }
+        }
+    }
+    out
+}
