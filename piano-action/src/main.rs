@@ -101,10 +101,7 @@ fn simulate_scenario(
     out: &std::path::Path,
 ) -> Result<(), String> {
     use piano_action::scenario::{InputSpec, Scenario, write_pendulum_dir, write_run_dir};
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let scenario =
-        Scenario::from_toml_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let scenario = Scenario::load(path).map_err(|e| e.to_string())?;
     if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
         let swing = piano_action::pendulum::swing(params, release_angle_deg, scenario.duration_s)
             .map_err(|e| format!("{}: {e}", path.display()))?;

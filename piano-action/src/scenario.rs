@@ -15,13 +15,22 @@ use crate::simulate::{Finger, Input, Run, TouchStyle, simulate};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum InputSpec {
-    /// A force on the key front (N), optionally released at `release_s`.
+    /// A force on the key front: `force_n` (N) from t = 0, reached after `ramp_s` if given
+    /// (a linear ramp), released at `release_s` if given; or a table
+    /// `points = [[time_s, force_n], ...]`, piecewise linear.
     Force {
         /// Force (N).
-        force_n: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        force_n: Option<f64>,
+        /// Rise time of a ramp (s).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ramp_s: Option<f64>,
         /// Release time (s).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         release_s: Option<f64>,
+        /// `[time_s, force_n]` points, instead of `force_n`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        points: Option<Vec<[f64; 2]>>,
     },
     /// A mass released on the key front from `height_m` (0: placed on it).
     MassDrop {
@@ -58,10 +67,16 @@ pub enum InputSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         arm_damping_n_s_m: Option<f64>,
     },
-    /// Prescribed key-front depth, `points = [[time_s, depth_mm], ...]`, piecewise linear.
+    /// Prescribed key-front depth below rest, `points = [[time_s, depth_mm], ...]`,
+    /// piecewise linear, or read from `csv = "FILE"` (two columns, time_s and depth_mm, an
+    /// optional header line; the path relative to the scenario file).
     Motion {
         /// `[time_s, depth_mm]` points.
-        points: Vec<[f64; 2]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        points: Option<Vec<[f64; 2]>>,
+        /// A CSV file of the points, instead of `points`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        csv: Option<String>,
     },
 }
 
@@ -79,7 +94,12 @@ impl InputSpec {
     /// The simulation input this spec describes; a missing or misplaced field is named.
     pub fn to_input(&self) -> Result<Input> {
         Ok(match self {
-            &InputSpec::Force { force_n, release_s } => Input::Force { force_n, release_s },
+            InputSpec::Force {
+                force_n,
+                ramp_s,
+                release_s,
+                points,
+            } => force_input(*force_n, *ramp_s, *release_s, points.as_deref())?,
             &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
             InputSpec::Pendulum { .. } => {
                 return Err(PianoError::Params {
@@ -89,8 +109,26 @@ impl InputSpec {
                         .into(),
                 });
             }
-            InputSpec::Motion { points } => Input::Motion {
-                points: points.iter().map(|p| (p[0], p[1])).collect(),
+            InputSpec::Motion { points, csv } => match (points, csv) {
+                // Both: the points were read from the csv by `load`.
+                (Some(points), _) => Input::Motion {
+                    points: points.iter().map(|p| (p[0], p[1])).collect(),
+                },
+                (None, Some(file)) => {
+                    return Err(PianoError::Params {
+                        field: "input.csv".into(),
+                        message: format!(
+                            "'{file}' is read by Scenario::load, which knows where the \
+                             scenario file is"
+                        ),
+                    });
+                }
+                _ => {
+                    return Err(PianoError::Params {
+                        field: "input.points".into(),
+                        message: "give either points or csv".into(),
+                    });
+                }
             },
             &InputSpec::Touch {
                 style,
@@ -143,6 +181,86 @@ impl InputSpec {
     }
 }
 
+/// The input of `kind = "force"`: a constant force, a ramp, a release, or a table.
+fn force_input(
+    force_n: Option<f64>,
+    ramp_s: Option<f64>,
+    release_s: Option<f64>,
+    points: Option<&[[f64; 2]]>,
+) -> Result<Input> {
+    let field = |name: &str, message: &str| PianoError::Params {
+        field: format!("input.{name}"),
+        message: message.into(),
+    };
+    if let Some(points) = points {
+        for (name, given) in [
+            ("force_n", force_n.is_some()),
+            ("ramp_s", ramp_s.is_some()),
+            ("release_s", release_s.is_some()),
+        ] {
+            if given {
+                return Err(field(name, "does not go with a points table"));
+            }
+        }
+        return Ok(Input::ForceTable {
+            points: points.iter().map(|p| (p[0], p[1])).collect(),
+        });
+    }
+    let force_n = force_n.ok_or_else(|| field("force_n", "needs force_n or points"))?;
+    let Some(ramp) = ramp_s else {
+        return Ok(Input::Force { force_n, release_s });
+    };
+    if !(ramp.is_finite() && ramp > 0.0) {
+        return Err(field("ramp_s", &format!("must be positive, got {ramp}")));
+    }
+    let mut table = vec![(0.0, 0.0), (ramp, force_n)];
+    if let Some(t) = release_s {
+        if !(t.is_finite() && t > ramp) {
+            return Err(field(
+                "release_s",
+                &format!("must come after the ramp ({ramp} s), got {t}"),
+            ));
+        }
+        table.extend([(t, force_n), (t + 1e-3, 0.0)]);
+    }
+    Ok(Input::ForceTable { points: table })
+}
+
+/// Reads `[time, value]` rows from CSV text (comma, semicolon, tab or space separated; a
+/// first line that is not numbers is a header); errors name the file and the line.
+pub fn read_points_csv(text: &str, file: &str) -> Result<Vec<[f64; 2]>> {
+    let bad = |line: usize, message: String| PianoError::Params {
+        field: "input.csv".into(),
+        message: format!("{file} line {line}: {message}"),
+    };
+    let mut points = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let cells: Vec<&str> = line
+            .split(|c: char| c == ',' || c == ';' || c == '\t' || c == ' ')
+            .filter(|c| !c.is_empty())
+            .collect();
+        let numbers: Vec<Option<f64>> = cells.iter().map(|c| c.parse().ok()).collect();
+        match numbers.as_slice() {
+            [Some(t), Some(v)] => points.push([*t, *v]),
+            _ if points.is_empty() && numbers.iter().any(Option::is_none) && i == 0 => {}
+            _ => {
+                return Err(bad(
+                    i + 1,
+                    format!("expected two numbers (time, value), got '{line}'"),
+                ));
+            }
+        }
+    }
+    if points.is_empty() {
+        return Err(bad(0, "no data rows".into()));
+    }
+    Ok(points)
+}
+
 /// A scenario file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -173,6 +291,43 @@ impl Scenario {
             field: e.path().to_string(),
             message: e.inner().to_string(),
         })
+    }
+
+    /// Reads and parses the scenario file at `path`, and reads a motion's `csv` (relative to
+    /// the scenario's folder) into its points. Errors name the file and the field.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| PianoError::Params {
+            field: String::new(),
+            message: format!("cannot read {}: {e}", path.display()),
+        })?;
+        let mut scenario = Self::from_toml_str(&text).map_err(|e| match e {
+            PianoError::Params { field, message } => PianoError::Params {
+                field,
+                message: format!("{message} (in {})", path.display()),
+            },
+            other => other,
+        })?;
+        if let InputSpec::Motion {
+            points,
+            csv: Some(file),
+        } = &mut scenario.input
+        {
+            if points.is_some() {
+                return Err(PianoError::Params {
+                    field: "input.csv".into(),
+                    message: "give either points or csv, not both".into(),
+                });
+            }
+            let full = path.parent().unwrap_or(Path::new(".")).join(&*file);
+            let text = std::fs::read_to_string(&full).map_err(|e| PianoError::Params {
+                field: "input.csv".into(),
+                message: format!("cannot read {}: {e}", full.display()),
+            })?;
+            *points = Some(read_points_csv(&text, &full.display().to_string())?);
+            // The points are now in the scenario (and its run.json); the file name stays as
+            // a record of where they came from.
+        }
+        Ok(scenario)
     }
 
     /// The model kind named by `model`.

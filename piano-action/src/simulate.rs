@@ -21,6 +21,12 @@ pub enum Input {
         /// Release time (s).
         release_s: Option<f64>,
     },
+    /// A vertical force on the key front following a table of `(time_s, force_n)` points,
+    /// piecewise linear, held at the last value (a ramp is two points).
+    ForceTable {
+        /// `(time_s, force_n)` points, times increasing; pressing down is positive.
+        points: Vec<(f64, f64)>,
+    },
     /// Prescribed key-front depth: `(time_s, depth_mm)` points, piecewise linear (corners
     /// rounded over at most 5 ms so the key's acceleration stays finite), held before the
     /// first point and after the last. Depth is measured at the finger point from the key's
@@ -178,34 +184,48 @@ impl Input {
                 }
                 Ok(())
             }
-            Input::Motion { ref points } => {
-                let bad = |message: String| PianoError::Params {
-                    field: "input.points".into(),
-                    message,
-                };
-                if points.is_empty() {
-                    return Err(bad("needs at least one [time_s, depth_mm] point".into()));
-                }
-                for (i, &(t, d)) in points.iter().enumerate() {
-                    if !(t.is_finite() && d.is_finite()) {
-                        return Err(bad(format!("point {i} is not finite: [{t}, {d}]")));
-                    }
-                    if !(-20.0..=20.0).contains(&d) {
-                        return Err(bad(format!(
-                            "point {i}: depth {d} mm is outside -20..20 mm (a key dips about 10)"
-                        )));
-                    }
-                    if i > 0 && t <= points[i - 1].0 {
-                        return Err(bad(format!(
-                            "point {i}: times must increase, got {t} after {}",
-                            points[i - 1].0
-                        )));
-                    }
-                }
-                Ok(())
-            }
+            Input::Motion { ref points } => check_table(points, "[time_s, depth_mm]", |d| {
+                (-20.0..=20.0).contains(&d).then_some(()).ok_or_else(|| {
+                    format!("depth {d} mm is outside -20..20 mm (a key dips about 10)")
+                })
+            }),
+            Input::ForceTable { ref points } => check_table(points, "[time_s, force_n]", |f| {
+                (-200.0..=200.0)
+                    .contains(&f)
+                    .then_some(())
+                    .ok_or_else(|| format!("force {f} N is outside -200..200 N"))
+            }),
         }
     }
+}
+
+/// Checks a `(time, value)` table (field `input.points`): at least one point, finite,
+/// times increasing, each value accepted by `value_ok`.
+fn check_table(
+    points: &[(f64, f64)],
+    what: &str,
+    value_ok: impl Fn(f64) -> std::result::Result<(), String>,
+) -> Result<()> {
+    let bad = |message: String| PianoError::Params {
+        field: "input.points".into(),
+        message,
+    };
+    if points.is_empty() {
+        return Err(bad(format!("needs at least one {what} point")));
+    }
+    for (i, &(t, v)) in points.iter().enumerate() {
+        if !(t.is_finite() && v.is_finite()) {
+            return Err(bad(format!("point {i} is not finite: [{t}, {v}]")));
+        }
+        value_ok(v).map_err(|m| bad(format!("point {i}: {m}")))?;
+        if i > 0 && t <= points[i - 1].0 {
+            return Err(bad(format!(
+                "point {i}: times must increase, got {t} after {}",
+                points[i - 1].0
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The key angle (rad) that puts the finger point `depth_mm` below its layout position.
@@ -486,6 +506,9 @@ pub fn simulate(
                 Some(t) => vec![(0.0, force_n), (t, force_n), (t + 1e-3, 0.0)],
             };
             action.add_key_force(PiecewiseLinear::new(table)?)?;
+        }
+        Input::ForceTable { ref points } => {
+            action.add_key_force(PiecewiseLinear::new(points.clone())?)?;
         }
         Input::Motion { ref points } => {
             let table: Vec<(f64, f64)> = points

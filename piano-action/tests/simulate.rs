@@ -87,3 +87,85 @@ fn bad_inputs_are_named() {
     .unwrap_err();
     assert!(e.to_string().contains("duration_s"), "{e}");
 }
+
+#[test]
+fn a_ramped_force_is_a_table_and_strikes_later_and_softer_than_a_step() {
+    use piano_action::scenario::Scenario;
+    let head = "model = \"double\"\nduration_s = 0.15\n[input]\nkind = \"force\"\n";
+    let ramp = Scenario::from_toml_str(&format!("{head}force_n = 8.0\nramp_s = 0.04\n")).unwrap();
+    assert_eq!(
+        ramp.input.to_input().unwrap(),
+        Input::ForceTable {
+            points: vec![(0.0, 0.0), (0.04, 8.0)]
+        }
+    );
+    let step = Scenario::from_toml_str(&format!("{head}force_n = 8.0\n")).unwrap();
+    let table =
+        Scenario::from_toml_str(&format!("{head}points = [[0.0, 0.0], [0.04, 8.0]]\n")).unwrap();
+    let params = ActionParams::reference();
+    let (ramp, step, table) = (
+        ramp.run(&params).unwrap(),
+        step.run(&params).unwrap(),
+        table.run(&params).unwrap(),
+    );
+    assert_eq!(ramp.strikes, table.strikes, "the same table");
+    let (r, s) = (ramp.strikes[0], step.strikes[0]);
+    assert!(r.time_s > s.time_s + 0.005, "ramp {r:?} step {s:?}");
+    assert!(
+        r.hammer_velocity_m_s < s.hammer_velocity_m_s,
+        "ramp {r:?} step {s:?}"
+    );
+    // Misplaced and missing fields are named.
+    for (body, field) in [
+        ("points = [[0.0, 1.0]]\nforce_n = 2.0\n", "input.force_n"),
+        ("ramp_s = 0.01\n", "input.force_n"),
+        (
+            "force_n = 2.0\nramp_s = 0.05\nrelease_s = 0.01\n",
+            "input.release_s",
+        ),
+        ("points = [[0.1, 1.0], [0.05, 2.0]]\n", "input.points"),
+    ] {
+        let e = Scenario::from_toml_str(&format!("{head}{body}"))
+            .and_then(|s| s.run(&params))
+            .unwrap_err();
+        assert!(e.to_string().contains(field), "{body}: {e}");
+    }
+}
+
+#[test]
+fn a_key_motion_can_come_from_a_csv_file_beside_the_scenario() {
+    use piano_action::scenario::Scenario;
+    let dir = std::env::temp_dir().join(format!("piano-motion-csv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("key.csv"),
+        "time_s,depth_mm\n0.0,0.0\n0.03,10.0\n# held\n0.08,10.0\n",
+    )
+    .unwrap();
+    let path = dir.join("motion.toml");
+    std::fs::write(
+        &path,
+        "model = \"double\"\nduration_s = 0.08\n[input]\nkind = \"motion\"\ncsv = \"key.csv\"\n",
+    )
+    .unwrap();
+    let from_csv = Scenario::load(&path).unwrap();
+    let inline = Scenario::from_toml_str(
+        "model = \"double\"\nduration_s = 0.08\n[input]\nkind = \"motion\"\npoints = [[0.0, 0.0], [0.03, 10.0], [0.08, 10.0]]\n",
+    )
+    .unwrap();
+    let params = ActionParams::reference();
+    let (a, b) = (from_csv.run(&params).unwrap(), inline.run(&params).unwrap());
+    assert!(!a.strikes.is_empty());
+    assert_eq!(a.strikes, b.strikes);
+    // A bad row names the file and the line; a missing file names it.
+    std::fs::write(dir.join("key.csv"), "0.0,0.0\n0.03,ten\n").unwrap();
+    let e = Scenario::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("input.csv") && e.contains("key.csv line 2"),
+        "{e}"
+    );
+    std::fs::remove_file(dir.join("key.csv")).unwrap();
+    let e = Scenario::load(&path).unwrap_err().to_string();
+    assert!(e.contains("input.csv") && e.contains("key.csv"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
