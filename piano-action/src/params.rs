@@ -255,6 +255,10 @@ pub struct NumericsParams {
     pub stop_stiffness_n_m_per_rad: f64,
     /// Damping of those stops (N·m·s/rad).
     pub stop_damping_n_m_s_per_rad: f64,
+    /// Relative error tolerance of the integrator (per step).
+    pub relative_tolerance: f64,
+    /// Absolute error tolerance of the integrator (rad, m, rad/s, m/s).
+    pub absolute_tolerance: f64,
 }
 
 /// The whole parameter set.
@@ -331,6 +335,14 @@ impl ActionParams {
             (
                 "numerics.contact_reference_speed_m_s",
                 self.numerics.contact_reference_speed_m_s,
+            ),
+            (
+                "numerics.relative_tolerance",
+                self.numerics.relative_tolerance,
+            ),
+            (
+                "numerics.absolute_tolerance",
+                self.numerics.absolute_tolerance,
             ),
         ];
         for (field, v) in positive {
