@@ -206,6 +206,62 @@ impl Contact {
         let mut rates = vec![0.0; self.normal.state_count()];
         self.compute(ctx, &mut rates)
     }
+
+    /// The body of each side (A, then B) and that side's shapes in the body's joint frame
+    /// (world coordinates for the ground), exactly as the contact uses them: place them with
+    /// the body's pose ([`Shape::placed`]) to draw or inspect the contact.
+    ///
+    /// ```
+    /// use mbs_contact::laws::KelvinVoigt;
+    /// use mbs_contact::{Contact, ContactSide, Shape};
+    /// use mbs_core::{BodyId, BodySpec, JointKind, ModelBuilder, Placement};
+    /// let mut b = ModelBuilder::new();
+    /// b.add_link("arm", None, JointKind::Revolute, Placement::offset(0.0, 1.0),
+    ///            BodySpec::new(1.0, [0.5, 0.0], 0.1));
+    /// let model = b.build()?;
+    /// let floor = Shape::segment([1.0, 0.0], [-1.0, 0.0])?;
+    /// let tip = Shape::circle([1.0, 0.0], 0.01)?;
+    /// let c = Contact::new(&model, "tip", ContactSide::ground(vec![floor]),
+    ///                      ContactSide::on("arm", vec![tip]), KelvinVoigt::new(1e4, 0.0)?)?;
+    /// let [(a, floor_shapes), (b, tip_shapes)] = c.sides();
+    /// assert_eq!(a, BodyId::GROUND);
+    /// assert_eq!((floor_shapes, tip_shapes), (&[floor][..], &[tip][..]));
+    /// assert_eq!(b, model.body_id("arm")?);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn sides(&self) -> [(BodyId, &[Shape]); 2] {
+        let [a, b] = &self.sides;
+        [(a.body, &a.shapes), (b.body, &b.shapes)]
+    }
+
+    /// The contact behind a force element of a `System` (`None` when the element is not a
+    /// [`Contact`]).
+    ///
+    /// ```
+    /// use mbs_contact::laws::KelvinVoigt;
+    /// use mbs_contact::{Contact, ContactSide, Shape};
+    /// use mbs_core::elements::{JointSpringDamper, SpringLaw};
+    /// use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System};
+    /// let mut b = ModelBuilder::new();
+    /// b.add_link("arm", None, JointKind::Revolute, Placement::offset(0.0, 1.0),
+    ///            BodySpec::new(1.0, [0.5, 0.0], 0.1));
+    /// let model = b.build()?;
+    /// let mut system = System::new(model.clone());
+    /// let spring = system.add_element(JointSpringDamper::new(&model, "arm",
+    ///                                                        SpringLaw::new(1.0, 0.0))?)?;
+    /// let tip = system.add_element(Contact::new(
+    ///     &model, "tip",
+    ///     ContactSide::ground(vec![Shape::segment([1.0, 0.0], [-1.0, 0.0])?]),
+    ///     ContactSide::on("arm", vec![Shape::circle([1.0, 0.0], 0.01)?]),
+    ///     KelvinVoigt::new(1e4, 0.0)?)?)?;
+    /// let element = |e: usize| system.elements().nth(e).ok_or("no such element");
+    /// assert!(Contact::of(element(tip)?).is_some());
+    /// assert!(Contact::of(element(spring)?).is_none());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn of(element: &dyn ForceElement) -> Option<&Contact> {
+        element.as_any()?.downcast_ref::<Contact>()
+    }
 }
 
 fn resolve(model: &Model, contact: &str, side: &ContactSide) -> Result<ResolvedSide> {
@@ -280,5 +336,9 @@ impl ForceElement for Contact {
 
     fn switch_direction(&self, _k: usize) -> Crossing {
         Crossing::Both
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 }

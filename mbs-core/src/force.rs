@@ -197,4 +197,12 @@ pub trait ForceElement: Send + Sync {
     fn switch_direction(&self, _k: usize) -> Crossing {
         Crossing::Both
     }
+
+    /// The element as [`Any`](std::any::Any), for code that knows its concrete type and
+    /// needs what the trait does not expose (a contact's shapes, to draw them):
+    /// `element.as_any()?.downcast_ref::<MyElement>()`. `None` by default; an element that
+    /// offers it returns `Some(self)`.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }

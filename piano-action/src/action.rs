@@ -115,7 +115,7 @@ pub struct Presser {
 
 impl Presser {
     /// A weight of `mass_kg` with its firm pad (Hunt–Crossley k = 1e7, p = 1.5, e = 0.5
-    /// [D]) `height_mm` above the key top.
+    /// \[D\]) `height_mm` above the key top.
     pub fn weight(mass_kg: f64, height_mm: f64) -> Self {
         Presser {
             mass_kg,
@@ -642,6 +642,29 @@ impl Action {
         Ok(self
             .system
             .initial_state(0.0, &vec![0.0; n], &vec![0.0; n])?)
+    }
+
+    /// What the named contact does at time `t` and state `x`: gap, forces, point, normal.
+    pub fn contact_output(
+        &self,
+        name: &str,
+        t: f64,
+        x: &[f64],
+    ) -> Result<mbs_contact::ContactOutput> {
+        let unknown = || mbs_core::CoreError::UnknownName {
+            what: "contact",
+            name: name.to_string(),
+        };
+        let e = *self.contacts.get(name).ok_or_else(unknown)?;
+        let mut ws = self.system.workspace();
+        let ctx = self.system.element_context(&mut ws, t, x, e)?;
+        let contact = self
+            .system
+            .elements()
+            .nth(e)
+            .and_then(Contact::of)
+            .ok_or_else(unknown)?;
+        Ok(contact.output(&ctx))
     }
 
     /// The gap (m) of the named contact at time `t` and state `x` (the time matters when a

@@ -1,21 +1,24 @@
 //! # piano-action: the grand piano action on the planar multibody framework
 //!
-//! **In progress.** Built so far: the parameter set (one documented TOML file, embedded as
-//! the default, loaded with errors that name the field); the three progressive models
-//! (simplified, single escapement, double escapement) assembled from it as
-//! `mbs_core::System`s with their joints, springs, pivot friction and felt contacts;
-//! keystrokes driven by a force on the key front, by a prescribed key-front motion (with
-//! the hand's force reported) or by a mass dropped on the key, integrated with TR-BDF2, with
-//! the piano events (let-off, string contact, key bottom, check, drop) and the strikes read
-//! off the contact events; the regulation measured and regulated into the literature bands
+//! The parameter set (one documented TOML file, embedded as the default, loaded with
+//! errors that name the field); the three progressive models (simplified, single
+//! escapement, double escapement) assembled from it as `mbs_core::System`s with their
+//! joints, springs, pivot friction and felt contacts ([`Action`]); keystrokes
+//! ([`simulate()`]) driven by a force on the key front (constant, ramp, table, release), a
+//! prescribed key-front motion (with the hand's force reported), a finger touch (pressed
+//! or struck, through a fingertip pad) or a mass dropped on the key, integrated with
+//! TR-BDF2 from the action settled at rest, with the piano events (key start, let-off,
+//! drop, string contact, key bottom, check, jack reset) and the strikes read off the
+//! contact events; the regulation measured and regulated like a technician's
 //! ([`regulation::measure`], [`regulation::regulate`]); the static touchweight
 //! ([`touchweight::measure`]); the hammer swing test ([`pendulum`]); scenarios and run
-//! directories ([`scenario`]). Finger touches, drawings and `piano sweep` are still to
-//! come.
+//! directories with drawings to scale ([`scenario`], [`drawing`]); parallel sweeps over
+//! touch levels ([`sweep`]).
 //!
 #![warn(missing_docs)]
 
 mod action;
+pub mod drawing;
 mod error;
 pub mod params;
 pub mod pendulum;
@@ -26,6 +29,7 @@ pub mod sweep;
 pub mod touchweight;
 
 pub use action::{Action, ModelKind, Presser};
+pub use drawing::action_svg;
 pub use error::{PianoError, Result};
 pub use params::ActionParams;
 pub use simulate::{Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate};

@@ -114,17 +114,8 @@ fn simulate_scenario(
         println!("run directory: {}", out.display());
         return Ok(());
     }
-    let kind = scenario
-        .model_kind()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
     let run = scenario.run(params).map_err(|e| e.to_string())?;
-    let names = piano_action::Action::build(params, kind)
-        .map_err(|e| e.to_string())?
-        .system
-        .model()
-        .coordinate_names()
-        .to_vec();
-    write_run_dir(out, &scenario, params, &run, &names).map_err(|e| e.to_string())?;
+    write_run_dir(out, &scenario, params, &run).map_err(|e| e.to_string())?;
     for s in &run.strikes {
         println!(
             "strike at {:.1} ms, hammer {:.2} m/s, contact {}",

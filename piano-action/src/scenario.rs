@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::action::ModelKind;
 use crate::error::{PianoError, Result};
 use crate::params::ActionParams;
-use crate::simulate::{Finger, Input, Run, TouchStyle, simulate};
+use crate::simulate::{Finger, Input, Prepared, Run, TouchStyle, simulate};
 
 /// The input of a scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -240,7 +240,7 @@ pub fn read_points_csv(text: &str, file: &str) -> Result<Vec<[f64; 2]>> {
             continue;
         }
         let cells: Vec<&str> = line
-            .split(|c: char| c == ',' || c == ';' || c == '\t' || c == ' ')
+            .split([',', ';', '\t', ' '])
             .filter(|c| !c.is_empty())
             .collect();
         let numbers: Vec<Option<f64>> = cells.iter().map(|c| c.parse().ok()).collect();
@@ -394,20 +394,26 @@ fn num(x: Option<f64>) -> serde_json::Value {
 
 /// Writes the run directory `dir` (created if needed): `run.json` (scenario and
 /// parameters), `trajectory.csv` (time, coordinates, velocities on the output grid),
-/// `events.json` and `summary.json` (strikes, let-off, key-bottom and check times, events).
+/// `contacts.csv` (gaps and normal forces on the same grid), `events.json`,
+/// `summary.json` (strikes, key start, travel, let-off, key-bottom and check times,
+/// events) and the drawings `drawing_rest.svg`, `drawing_let_off.svg`,
+/// `drawing_string_contact.svg` and `drawing_check.svg` (those that happen).
 pub fn write_run_dir(
     dir: &Path,
     scenario: &Scenario,
     params: &ActionParams,
     run: &Run,
-    names: &[String],
 ) -> Result<()> {
     start_run_dir(dir, scenario, params)?;
 
+    // The action as the run had it (with a presser, if any), for the names, the contacts
+    // and the drawings.
+    let prepared = crate::simulate::prepare(params, run.kind, &scenario.input.to_input()?)?;
+    let names = prepared.action.system.model().coordinate_names().to_vec();
     let sol = &run.solution;
     let nv = names.len();
     let mut csv = String::from("time_s");
-    for n in names {
+    for n in &names {
         let _ = write!(csv, ",{n}_q");
     }
     for n in names {
@@ -429,6 +435,7 @@ pub fn write_run_dir(
         csv.push('\n');
     }
     write_file(dir, "trajectory.csv", &csv)?;
+    write_contacts_and_drawings(dir, &prepared, run)?;
 
     let events: Vec<serde_json::Value> = run
         .events
@@ -463,6 +470,67 @@ pub fn write_run_dir(
         "events": events,
     });
     write_json(dir, "summary.json", &summary)?;
+    Ok(())
+}
+
+/// Writes `contacts.csv` (every contact's gap and normal force on the output grid) and the
+/// drawings of the action at rest, at let-off, at string contact and at the check (those
+/// that happen), with the pressed contacts marked.
+fn write_contacts_and_drawings(dir: &Path, prepared: &Prepared, run: &Run) -> Result<()> {
+    let action = &prepared.action;
+    let sol = &run.solution;
+    let names: Vec<&str> = action.contacts.keys().copied().collect();
+    let mut csv = String::from("time_s");
+    for n in &names {
+        let _ = write!(csv, ",{n}_gap_mm,{n}_force_n");
+    }
+    csv.push('\n');
+    for i in 0..sol.len() {
+        let (t, x) = (sol.t[i], sol.state(i));
+        let _ = write!(csv, "{t}");
+        for n in &names {
+            let out = action.contact_output(n, t, x)?;
+            let _ = write!(csv, ",{},{}", out.gap * 1e3, out.normal_force);
+        }
+        csv.push('\n');
+    }
+    write_file(dir, "contacts.csv", &csv)?;
+
+    // The state at an event is the integrator's, just past the crossing.
+    let at = |time: Option<f64>| {
+        time.and_then(|t| {
+            sol.events
+                .iter()
+                .find(|e| e.time == t)
+                .map(|e| (t, e.state.clone()))
+        })
+    };
+    let model = run.kind.name();
+    let shots = [
+        ("rest", Some((0.0, prepared.x0.clone())), "at rest"),
+        (
+            "let_off",
+            at(run.let_off_time_s),
+            "let-off (jack toe on the button)",
+        ),
+        (
+            "string_contact",
+            at(run.strikes.first().map(|s| s.time_s)),
+            "string contact",
+        ),
+        (
+            "check",
+            at(run.check_time_s),
+            "check (tail on the backcheck)",
+        ),
+    ];
+    for (file, state, what) in shots {
+        if let Some((t, x)) = state {
+            let title = format!("{model} action, {what}, t = {:.1} ms", t * 1e3);
+            let svg = crate::drawing::action_svg(action, t, &x, &title)?;
+            write_file(dir, &format!("drawing_{file}.svg"), &svg)?;
+        }
+    }
     Ok(())
 }
 

@@ -90,7 +90,7 @@ pub struct Finger {
 }
 
 impl Default for Finger {
-    /// A fingertip derived for this model [D]: 20 g effective mass, the pressed force
+    /// A fingertip derived for this model \[D\]: 20 g effective mass, the pressed force
     /// rising over 30 ms, an arm coupling of 20 N·s/m (a 1 m/s finger holds 20 N on the
     /// bottomed key, inside the 8-50 N staccato peaks of Kinoshita et al. 2007), and a pulp
     /// stiffening as `k δ²` with k = 2e6 N/m² (2 N at 1 mm, 50 N at 5 mm), restitution 0.2.
@@ -436,21 +436,20 @@ const EVENT_NAMES: [(&str, &str, &str); 6] = [
     ("drop_screw", "drop", "drop_release"),
 ];
 
-/// Simulates `kind` driven by `input` for `duration_s`, with output every `output_step_s`.
-pub fn simulate(
-    params: &ActionParams,
-    kind: ModelKind,
-    input: &Input,
-    duration_s: f64,
-    output_step_s: f64,
-) -> Result<Run> {
+/// An action assembled for an input, and its starting state.
+pub struct Prepared {
+    /// The action with the input's bodies and forces (presser, finger, drive).
+    pub action: Action,
+    /// The state at t = 0: the action settled at rest, the presser placed and moving.
+    pub x0: Vec<f64>,
+    /// Key-front depth of the rest below the layout (mm).
+    pub rest_depth_mm: f64,
+}
+
+/// Assembles `kind` with what `input` adds (a presser and its forces, a key force or a
+/// key drive) and the starting state, settled at rest; the input is checked first.
+pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<Prepared> {
     input.validate()?;
-    if !(duration_s.is_finite() && duration_s > 0.0) {
-        return Err(PianoError::Params {
-            field: "duration_s".into(),
-            message: format!("must be positive, got {duration_s}"),
-        });
-    }
     let presser = match *input {
         Input::MassDrop { mass_kg, height_m } => Some(Presser::weight(mass_kg, height_m * 1e3)),
         Input::Touch { style, finger } => Some(Presser {
@@ -521,6 +520,34 @@ pub fn simulate(
         }
     }
     let x0 = action.system.initial_state(0.0, &q0, &v0)?;
+    Ok(Prepared {
+        action,
+        x0,
+        rest_depth_mm,
+    })
+}
+
+/// Simulates `kind` driven by `input` for `duration_s`, with output every `output_step_s`.
+pub fn simulate(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    duration_s: f64,
+    output_step_s: f64,
+) -> Result<Run> {
+    if !(duration_s.is_finite() && duration_s > 0.0) {
+        return Err(PianoError::Params {
+            field: "duration_s".into(),
+            message: format!("must be positive, got {duration_s}"),
+        });
+    }
+    let Prepared {
+        action,
+        x0,
+        rest_depth_mm,
+    } = prepare(params, kind, input)?;
+    let model = action.system.model().clone();
+    let nv = model.nv();
     let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
     let mut key_drive_force_n = Vec::new();
     if matches!(input, Input::Motion { .. }) {

@@ -82,6 +82,34 @@ fn simulate_writes_a_run_directory_with_the_summary() {
     );
     assert_eq!(csv.lines().count(), 1 + 81, "header and 81 grid rows");
     assert!(out.join("run.json").exists() && out.join("events.json").exists());
+    // Gaps and forces of every contact on the same grid; the string's force is up during
+    // the blow and zero at rest.
+    let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
+    let header: Vec<&str> = contacts.lines().next().unwrap().split(',').collect();
+    assert_eq!(contacts.lines().count(), 1 + 81);
+    let col = header
+        .iter()
+        .position(|h| *h == "hammer_string_force_n")
+        .unwrap();
+    let peak = contacts
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap().parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
+    assert!(peak > 10.0, "string force peaks at {peak} N on the grid");
+    // The drawings, with the string contact marked in its own.
+    for name in ["rest", "let_off", "string_contact", "check"] {
+        let svg = std::fs::read_to_string(out.join(format!("drawing_{name}.svg"))).unwrap();
+        assert!(
+            svg.starts_with("<svg") || svg.starts_with("<?xml"),
+            "{name}"
+        );
+        assert_eq!(
+            svg.contains("active-hammer_string"),
+            name == "string_contact",
+            "{name}"
+        );
+    }
     // A key-motion scenario: a quick 10 mm press in 20 ms strikes, and the hand's force is
     // in the trajectory.
     std::fs::write(

@@ -1,0 +1,1000 @@
+//! To-scale drawings of the action as SVG, the way a piano technician sees it from the side:
+//! the key along the bottom on its key frame, the wippen over the key's back half, the jack
+//! under the hammer knuckle, the repetition lever, the hammer with its shank toward the
+//! string, and the fixed parts (rails, let-off button, drop screw, rest rail, string).
+//!
+//! Every outline is built from the parameters in their rest place and carried by its body's
+//! world pose at `(t, x)`, as the system computes it (a prescribed coordinate takes its
+//! drive's value). Over the outlines, thin lines show the contact shapes the simulation
+//! actually uses, and a red dot marks each contact that is pressed (gap < 0). The drawing is
+//! in millimetres, one SVG unit to the millimetre, with a 10 mm scale bar.
+//!
+//! ```
+//! use piano_action::{Action, ActionParams, ModelKind, drawing::action_svg};
+//! let action = Action::build(&ActionParams::reference(), ModelKind::Double)?;
+//! let svg = action_svg(&action, 0.0, &action.layout_state()?, "double escapement at rest")?;
+//! assert!(svg.starts_with("<svg") && svg.contains(r#"id="body-hammer""#));
+//! # Ok::<(), piano_action::PianoError>(())
+//! ```
+
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::fmt::Write;
+
+use mbs_contact::{Contact, Shape};
+use mbs_core::{CoreError, Data, Transform, frame_pose, update_poses};
+
+use crate::action::{Action, ModelKind};
+use crate::error::Result;
+
+/// Blank space around the action's outline on every side of the drawing (mm).
+pub const MARGIN_MM: f64 = 12.0;
+
+/// Length of the scale bar (mm).
+pub const SCALE_BAR_MM: f64 = 10.0;
+
+// Drawing-only dimensions (mm): what the parameters do not fix, chosen to look like a real
+// grand action. None of them affects the simulation.
+/// Key front in front of the finger point.
+const KEY_FRONT_LIP: f64 = 5.0;
+/// Key tail behind the back-rail pad.
+const KEY_TAIL: f64 = 10.0;
+/// Length and thickness of the key covering (natural keytop).
+const KEYTOP: [f64; 2] = [145.0, 2.0];
+/// Height of the key-frame rails under their felt.
+const RAIL_HEIGHT: f64 = 22.0;
+/// Felt punchings and cloths on the rails.
+const FELT: f64 = 2.0;
+/// Half thickness of the wippen body.
+const WIPPEN_HALF: f64 = 5.0;
+/// Hammer shank diameter (Ellis: 6.1–6.6 mm knuckle stock).
+const SHANK: f64 = 6.4;
+/// Backcheck head thickness behind its face.
+const BACKCHECK_THICK: f64 = 5.0;
+/// Space above the action for the title, and below it for the legend.
+const TITLE_SPACE: f64 = 12.0;
+const LEGEND_SPACE: f64 = 16.0;
+
+/// Fill colours: muted, one per body.
+const KEY_FILL: &str = "#dccaa4";
+const KEYTOP_FILL: &str = "#f6f3ea";
+const WIPPEN_FILL: &str = "#b9c9a4";
+const JACK_FILL: &str = "#cfa7a2";
+const LEVER_FILL: &str = "#a6b8cc";
+const SHANK_FILL: &str = "#e0cfa8";
+const MOLDING_FILL: &str = "#b89c74";
+const HAMMER_FELT_FILL: &str = "#efe9da";
+const BUCKSKIN_FILL: &str = "#a88d6c";
+const RAIL_FILL: &str = "#c9c5bd";
+const FELT_FILL: &str = "#8aa37a";
+const CLOTH_FILL: &str = "#b46a6a";
+const METAL_FILL: &str = "#9a9a9a";
+const BRASS_FILL: &str = "#c8a85a";
+const PRESSER_FILL: &str = "#8f8f99";
+const CONTACT_STROKE: &str = "#1f4e9c";
+const ACTIVE_FILL: &str = "#d62020";
+
+type P = [f64; 2];
+
+fn add(a: P, b: P) -> P {
+    [a[0] + b[0], a[1] + b[1]]
+}
+
+fn sub(a: P, b: P) -> P {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+fn mul(a: P, s: f64) -> P {
+    [a[0] * s, a[1] * s]
+}
+
+/// `a` normalised, or `fallback` when it has no length.
+fn unit(a: P, fallback: P) -> P {
+    let n = a[0].hypot(a[1]);
+    if n > 1e-9 { mul(a, 1.0 / n) } else { fallback }
+}
+
+/// Points on the circle `(c, r)` from angle `a0` to `a1` (rad, either direction).
+fn arc(c: P, r: f64, a0: f64, a1: f64) -> Vec<P> {
+    let n = ((a1 - a0).abs() / (PI / 24.0)).ceil().max(2.0) as usize;
+    (0..=n)
+        .map(|i| {
+            let a = a0 + (a1 - a0) * i as f64 / n as f64;
+            [c[0] + r * a.cos(), c[1] + r * a.sin()]
+        })
+        .collect()
+}
+
+fn rect(x: [f64; 2], y: [f64; 2]) -> Vec<P> {
+    vec![[x[0], y[0]], [x[1], y[0]], [x[1], y[1]], [x[0], y[1]]]
+}
+
+/// One filled outline.
+#[derive(Clone, Debug)]
+enum Outline {
+    Polygon(Vec<P>),
+    Circle(P, f64),
+    /// A thick line (wire, screw shank): points and width.
+    Wire(Vec<P>, f64),
+}
+
+/// A name written beside a part: the point it names (carried with the part), where the
+/// text stands from it (mm, not turned), and which end of the text stands there.
+#[derive(Clone, Debug)]
+struct Label {
+    anchor: P,
+    offset: P,
+    text: &'static str,
+    align: &'static str,
+}
+
+/// A drawn part: outlines in the rest layout (world mm), carried by one frame's motion
+/// (`None`: fixed to the ground).
+#[derive(Clone, Debug)]
+struct Part {
+    id: &'static str,
+    frame: Option<&'static str>,
+    pieces: Vec<(Outline, &'static str)>,
+    pivots: Vec<P>,
+    labels: Vec<Label>,
+}
+
+impl Part {
+    fn new(id: &'static str, frame: Option<&'static str>) -> Self {
+        Self {
+            id,
+            frame,
+            pieces: Vec::new(),
+            pivots: Vec::new(),
+            labels: Vec::new(),
+        }
+    }
+
+    /// Names `anchor` with `text` written at `offset` from it (a leader line joins them when
+    /// the offset is not zero); `align` is the SVG `text-anchor`.
+    fn label(&mut self, anchor: P, offset: P, text: &'static str, align: &'static str) {
+        self.labels.push(Label {
+            anchor,
+            offset,
+            text,
+            align,
+        });
+    }
+
+    fn polygon(&mut self, pts: Vec<P>, fill: &'static str) {
+        self.pieces.push((Outline::Polygon(pts), fill));
+    }
+
+    fn circle(&mut self, c: P, r: f64, fill: &'static str) {
+        self.pieces.push((Outline::Circle(c, r), fill));
+    }
+
+    fn wire(&mut self, pts: Vec<P>, width: f64, fill: &'static str) {
+        self.pieces.push((Outline::Wire(pts, width), fill));
+    }
+}
+
+/// The key: stick with keytop, balance pivot and capstan (the backcheck is
+/// [`backcheck_part`], drawn over the hammer).
+fn key_part(action: &Action) -> Part {
+    let (k, g) = (&action.params.key, &action.params.regulation);
+    let mut part = Part::new("body-key", Some("key"));
+    let bottom = k.pivot_mm[1];
+    let top = k.finger_mm[1];
+    let front = k.finger_mm[0] - KEY_FRONT_LIP;
+    let back = k.back_pad_mm[0] + k.back_pad_radius_mm + KEY_TAIL;
+    part.polygon(rect([front, back], [bottom, top]), KEY_FILL);
+    part.polygon(
+        rect([front - 0.5, front + KEYTOP[0]], [top, top + KEYTOP[1]]),
+        KEYTOP_FILL,
+    );
+    // Capstan: a screw standing in the key, its head where the model puts it.
+    let cap = [
+        k.capstan_center_mm[0],
+        k.capstan_center_mm[1] + g.capstan_raise_mm,
+    ];
+    let r = k.capstan_radius_mm;
+    if cap[1] > top {
+        part.polygon(
+            rect([cap[0] - 0.7 * r, cap[0] + 0.7 * r], [top, cap[1]]),
+            BRASS_FILL,
+        );
+    }
+    part.circle(cap, r, BRASS_FILL);
+    part.pivots.push(k.pivot_mm);
+    let mid = 0.5 * (bottom + top) - 1.0;
+    part.label([front + 60.0, mid], [0.0, 0.0], "key", "middle");
+    part.label([cap[0], mid], [0.0, 0.0], "capstan", "middle");
+    part
+}
+
+/// The backcheck on the key: the head with its leather face where the model puts the
+/// face, on a wire standing up from the key top.
+fn backcheck_part(action: &Action) -> Part {
+    let (k, g, h) = (
+        &action.params.key,
+        &action.params.regulation,
+        &action.params.hammer,
+    );
+    let mut part = Part::new("key-backcheck", Some("key"));
+    // The face direction, turned (as the model does) so the hammer tail at rest lies on
+    // its outward side, and pointing up.
+    let a = k.backcheck_face_angle_deg.to_radians();
+    let mut d = [a.cos(), a.sin()];
+    let (s, c) = h.rest_angle_deg.to_radians().sin_cos();
+    let tb = h.tail_body_mm;
+    let tail = [
+        h.pivot_mm[0] + c * tb[0] - s * tb[1],
+        h.pivot_mm[1] + s * tb[0] + c * tb[1],
+    ];
+    let to_tail = sub(tail, k.backcheck_mm);
+    if d[1] < 0.0 {
+        d = mul(d, -1.0);
+    }
+    let n = [-d[1], d[0]];
+    let n = if n[0] * to_tail[0] + n[1] * to_tail[1] >= 0.0 {
+        n
+    } else {
+        mul(n, -1.0)
+    };
+    let mid = add(k.backcheck_mm, mul(n, g.backcheck_offset_mm));
+    let hl = k.backcheck_half_length_mm;
+    let (lo, hi) = (sub(mid, mul(d, hl)), add(mid, mul(d, hl)));
+    let felt = 1.5;
+    let back = mul(n, -BACKCHECK_THICK);
+    let foot = add(lo, mul(back, 0.6));
+    part.wire(vec![foot, [foot[0], k.finger_mm[1]]], 1.2, METAL_FILL);
+    part.polygon(
+        vec![
+            sub(lo, mul(n, felt)),
+            sub(hi, mul(n, felt)),
+            add(hi, back),
+            add(lo, back),
+        ],
+        MOLDING_FILL,
+    );
+    part.polygon(
+        vec![lo, hi, sub(hi, mul(n, felt)), sub(lo, mul(n, felt))],
+        BUCKSKIN_FILL,
+    );
+    part.label(add(lo, back), [12.0, -3.0], "backcheck", "start");
+    part
+}
+
+/// The wippen: body from the jack centre to its flange, heel down onto the capstan, and the
+/// repetition-lever post when there is a lever. In the simplified model the jack is part
+/// of it.
+fn wippen_part(action: &Action, jack_fixed: bool, with_lever: bool) -> Part {
+    let p = &action.params;
+    let (w, j, r) = (&p.wippen, &p.jack, &p.repetition_lever);
+    let mut part = Part::new("body-wippen", Some("wippen"));
+    let (jp, wp) = (j.pivot_mm, w.pivot_mm);
+    let u = unit(sub(wp, jp), [1.0, 0.0]);
+    let n = if u[0] >= 0.0 {
+        [-u[1], u[0]]
+    } else {
+        [u[1], -u[0]]
+    };
+    let len = (wp[0] - jp[0]).hypot(wp[1] - jp[1]);
+    let along = |q: P| (q[0] - jp[0]) * u[0] + (q[1] - jp[1]) * u[1];
+    let top = |s: f64| add(add(jp, mul(u, s)), mul(n, WIPPEN_HALF));
+    let bot = |s: f64| sub(add(jp, mul(u, s)), mul(n, WIPPEN_HALF));
+    let heel = w.heel_mm;
+    let hl = w.heel_half_length_mm;
+    let s_heel = along(heel);
+    let mut outline = vec![top(-6.0)];
+    if with_lever {
+        let rp = r.pivot_mm;
+        let s_rp = along(rp);
+        outline.extend([
+            top(s_rp - 9.0),
+            [rp[0] - 4.0, rp[1] + 4.0],
+            [rp[0] + 4.0, rp[1] + 4.0],
+            top(s_rp + 9.0),
+        ]);
+    }
+    outline.extend([
+        top(len + 7.0),
+        bot(len + 7.0),
+        bot(s_heel + hl + 2.0),
+        [heel[0] + hl, heel[1] + 6.0],
+        [heel[0] + hl, heel[1]],
+        [heel[0] - hl, heel[1]],
+        [heel[0] - hl, heel[1] + 6.0],
+        bot(s_heel - hl - 2.0),
+        bot(-6.0),
+    ]);
+    part.polygon(outline, WIPPEN_FILL);
+    // Heel cushion.
+    part.polygon(
+        rect([heel[0] - hl, heel[0] + hl], [heel[1], heel[1] + FELT]),
+        FELT_FILL,
+    );
+    if jack_fixed {
+        part.polygon(jack_outline(action), WIPPEN_FILL);
+    }
+    part.pivots.push(wp);
+    if with_lever {
+        part.pivots.push(r.pivot_mm);
+    }
+    part.label([heel[0], heel[1] + 14.0], [0.0, 0.0], "wippen", "middle");
+    part
+}
+
+/// The jack as an L: the upright along its axis with the top under the knuckle, the toe
+/// (tender) reaching forward under the let-off button.
+fn jack_outline(action: &Action) -> Vec<P> {
+    let j = &action.params.jack;
+    let n = unit(j.axis, [0.0, 1.0]);
+    let t = [n[1], -n[0]];
+    let (top, jp) = (j.top_mm, j.pivot_mm);
+    let front_top = sub(top, mul(t, j.top_front_edge_mm));
+    let back_top = add(top, mul(t, j.top_back_edge_mm));
+    let wb = j.top_back_edge_mm.max(2.5);
+    let foot = 4.0;
+    let tr = j.toe_radius_mm;
+    let toe_c = [j.toe_mm[0], j.toe_mm[1] - tr];
+    // Where the front edge comes down to just above the toe.
+    let s = ((front_top[1] - (j.toe_mm[1] + 1.5)) / n[1].max(0.2)).max(0.0);
+    let front_low = sub(front_top, mul(n, s));
+    let mut outline = vec![
+        front_top,
+        back_top,
+        add(jp, mul(t, wb)),
+        sub(add(jp, mul(t, wb)), mul(n, foot)),
+        [toe_c[0] + 1.0, toe_c[1] - tr - 0.8],
+    ];
+    outline.extend(arc(toe_c, tr + 0.8, 1.5 * PI, 0.5 * PI));
+    outline.push(front_low);
+    outline
+}
+
+fn jack_part(action: &Action) -> Part {
+    let j = &action.params.jack;
+    let mut part = Part::new("body-jack", Some("jack"));
+    part.polygon(jack_outline(action), JACK_FILL);
+    part.pivots.push(j.pivot_mm);
+    part.label(j.toe_mm, [-5.0, -6.0], "jack", "end");
+    part
+}
+
+/// The repetition lever: its top under the knuckle beside the jack top, its front tip under
+/// the drop screw, pinned on the wippen's post.
+fn lever_part(action: &Action) -> Part {
+    let (r, j) = (&action.params.repetition_lever, &action.params.jack);
+    let mut part = Part::new("body-repetition_lever", Some("repetition_lever"));
+    let n = unit(j.axis, [0.0, 1.0]);
+    let t = [n[1], -n[0]];
+    let (rp, top) = (r.pivot_mm, r.top_mm);
+    let f1 = sub(top, mul(t, r.top_front_edge_mm));
+    let b1 = add(top, mul(t, r.top_back_edge_mm));
+    let depth = 6.0;
+    let tr = r.tip_radius_mm;
+    let tip_c = [r.tip_mm[0], r.tip_mm[1] - tr];
+    let mut outline = vec![
+        r.tip_mm,
+        f1,
+        b1,
+        [rp[0] + 6.0, rp[1] + 4.0],
+        [rp[0] + 11.0, rp[1] + 2.0],
+        [rp[0] + 11.0, rp[1] - 4.0],
+        [rp[0], rp[1] - 5.0],
+        [b1[0], b1[1] - depth],
+        [f1[0], f1[1] - depth],
+        [tip_c[0] + 1.5, tip_c[1] - 4.0],
+    ];
+    outline.extend(arc(tip_c, tr + 0.5, 1.25 * PI, 0.5 * PI));
+    part.polygon(outline, LEVER_FILL);
+    part.pivots.push(rp);
+    let under = [0.5 * (b1[0] + rp[0]), 0.5 * (b1[1] + rp[1]) - depth];
+    part.label(under, [0.0, -4.0], "repetition lever", "middle");
+    part
+}
+
+/// The hammer in its shank frame: butt with the knuckle, shank, moulding with the tail,
+/// felt with its crown; carried to the rest layout by the hammer's rest pose.
+fn hammer_part(action: &Action, rest: &Transform) -> Part {
+    let h = &action.params.hammer;
+    let mut part = Part::new("body-hammer", Some("hammer"));
+    let to_rest = |q: P| map(rest, q);
+    let place = |pts: Vec<P>| pts.into_iter().map(to_rest).collect::<Vec<_>>();
+    let (k, kr) = (h.knuckle_body_mm, h.knuckle_radius_mm);
+    let ys = [h.rest_body_mm[1], h.rest_body_mm[1] + SHANK];
+    let cr = h.crown_radius_mm;
+    let crown_c = [h.strike_body_mm[0], h.strike_body_mm[1] - cr];
+    let hw = cr + 2.0;
+    let head_x = [crown_c[0] - hw, crown_c[0] + hw];
+    let y_m = (ys[1] + 6.0).min(crown_c[1] - 2.0);
+    let tail = h.tail_body_mm;
+    let tr = h.tail_radius_mm;
+    // Butt: the wood round the centre pin, carrying the knuckle.
+    part.polygon(
+        place(vec![
+            [-7.0, ys[1] + 1.0],
+            [k[0] + kr + 2.0, ys[1]],
+            [k[0] + kr + 2.0, ys[0]],
+            [k[0], k[1]],
+            [-7.0, ys[0] - 2.0],
+        ]),
+        SHANK_FILL,
+    );
+    part.circle(to_rest(k), kr, BUCKSKIN_FILL);
+    part.polygon(place(rect([0.0, head_x[0] + 1.0], ys)), SHANK_FILL);
+    // Moulding: its tail hangs down to the catch point, whose back rises steeply (the
+    // backcheck face lies along it when it checks the hammer).
+    part.polygon(
+        place(vec![
+            [head_x[0], y_m],
+            [head_x[1], y_m],
+            [head_x[1] - 1.0, ys[0] - 1.0],
+            [tail[0] + tr + 0.25 * (ys[0] - 1.0 - tail[1]), ys[0] - 1.0],
+            [tail[0] + tr, tail[1]],
+            [tail[0], tail[1] - tr],
+            [tail[0] - 3.0, tail[1] + 1.5],
+            [head_x[0], ys[0] - 1.0],
+        ]),
+        MOLDING_FILL,
+    );
+    let mut felt = vec![[head_x[0], y_m], [head_x[1], y_m]];
+    felt.extend(arc(crown_c, cr, 0.0, PI));
+    part.polygon(place(felt), HAMMER_FELT_FILL);
+    part.pivots.push(h.pivot_mm);
+    part.label(
+        to_rest([0.55 * head_x[0], ys[1]]),
+        [0.0, 4.0],
+        "hammer shank",
+        "middle",
+    );
+    part.label(to_rest([head_x[1], y_m]), [8.0, 0.0], "hammer", "start");
+    part
+}
+
+/// The presser on the key front (a weight or a fingertip): its pad and a block above it.
+fn presser_part(rest: &Transform) -> Part {
+    let mut part = Part::new("body-presser", Some("presser"));
+    let place = |pts: Vec<P>| pts.into_iter().map(|q| map(rest, q)).collect::<Vec<_>>();
+    part.polygon(place(rect([-15.0, 15.0], [4.0, 34.0])), PRESSER_FILL);
+    part.polygon(place(rect([-3.0, 3.0], [-4.0, 4.5])), PRESSER_FILL);
+    part.label(map(rest, [0.0, 18.0]), [0.0, 0.0], "presser", "middle");
+    part
+}
+
+/// The key frame with its rails, the let-off button and its rail, the drop screw, the
+/// wippen and hammer flanges, the rest rail and the string.
+fn fixed_part(action: &Action) -> Part {
+    let p = &action.params;
+    let (k, g, w, h) = (&p.key, &p.regulation, &p.wippen, &p.hammer);
+    let mut part = Part::new("fixed-parts", None);
+    let low = g
+        .front_rail_top_y_mm
+        .min(g.back_rail_top_y_mm)
+        .min(k.pivot_mm[1])
+        - RAIL_HEIGHT;
+    let fx = g.front_rail_x_mm;
+    let bx = g.back_rail_x_mm;
+    let kp = k.pivot_mm;
+    // Key frame and its three rails, with punchings and cloth.
+    part.polygon(rect([fx[0] - 6.0, bx[1]], [low - 4.0, low]), RAIL_FILL);
+    part.polygon(
+        rect(
+            [fx[0] - 4.0, fx[1] + 4.0],
+            [low, g.front_rail_top_y_mm - FELT],
+        ),
+        RAIL_FILL,
+    );
+    part.polygon(
+        rect(fx, [g.front_rail_top_y_mm - FELT, g.front_rail_top_y_mm]),
+        CLOTH_FILL,
+    );
+    part.polygon(
+        rect([kp[0] - 12.0, kp[0] + 12.0], [low, kp[1] - FELT]),
+        RAIL_FILL,
+    );
+    part.polygon(
+        rect([kp[0] - 5.0, kp[0] + 5.0], [kp[1] - FELT, kp[1]]),
+        CLOTH_FILL,
+    );
+    part.polygon(
+        rect([kp[0] - 0.8, kp[0] + 0.8], [kp[1] - FELT, kp[1] + 12.0]),
+        METAL_FILL,
+    );
+    part.polygon(
+        rect(bx, [low, g.back_rail_top_y_mm - FELT - 1.0]),
+        RAIL_FILL,
+    );
+    part.polygon(
+        rect(
+            bx,
+            [g.back_rail_top_y_mm - FELT - 1.0, g.back_rail_top_y_mm],
+        ),
+        FELT_FILL,
+    );
+    let under = low - 9.0;
+    part.label(
+        [0.5 * (fx[0] + fx[1]), under],
+        [0.0, 0.0],
+        "front rail",
+        "middle",
+    );
+    part.label([kp[0], under], [0.0, 0.0], "balance rail", "middle");
+    part.label(
+        [0.5 * (bx[0] + bx[1]), under],
+        [0.0, 0.0],
+        "back rail",
+        "middle",
+    );
+    // Let-off button hanging from its rail on a screw.
+    if action.contacts.contains_key("let_off_button") {
+        let (x, y) = (g.let_off_button_x_mm, g.let_off_button_y_mm);
+        let c = 0.5 * (x[0] + x[1]);
+        part.polygon(rect([c - 10.0, c + 4.0], [y + 16.0, y + 26.0]), RAIL_FILL);
+        part.polygon(rect([c - 1.0, c + 1.0], [y + 5.5, y + 16.0]), METAL_FILL);
+        part.polygon(rect(x, [y + FELT, y + 5.5]), MOLDING_FILL);
+        part.polygon(rect(x, [y, y + FELT]), CLOTH_FILL);
+        part.label([x[0], y + 2.0], [-3.0, 0.0], "let-off button", "end");
+    }
+    // Hammer flange and its rail; the drop screw goes down through the flange.
+    let hp = h.pivot_mm;
+    part.polygon(
+        rect([hp[0] - 27.0, hp[0] - 7.0], [hp[1] - 8.0, hp[1] + 9.0]),
+        RAIL_FILL,
+    );
+    part.polygon(
+        vec![
+            [hp[0] - 7.0, hp[1] + 8.0],
+            [hp[0] + 5.0, hp[1] + 6.0],
+            [hp[0] + 5.0, hp[1] - 5.0],
+            [hp[0] - 7.0, hp[1] - 7.0],
+        ],
+        RAIL_FILL,
+    );
+    part.label(
+        [hp[0] - 17.0, hp[1] - 1.0],
+        [0.0, 0.0],
+        "flange rail",
+        "middle",
+    );
+    if action.contacts.contains_key("drop_screw") {
+        let (x, y) = (g.drop_screw_x_mm, g.drop_screw_y_mm);
+        let c = 0.5 * (x[0] + x[1]);
+        part.polygon(rect([c - 1.2, c + 1.2], [y, hp[1] - 3.0]), METAL_FILL);
+        part.label([c - 1.2, y + 1.0], [-3.0, 0.0], "drop screw", "end");
+    }
+    // Wippen flange.
+    let wp = w.pivot_mm;
+    part.polygon(
+        rect([wp[0] - 5.0, wp[0] + 5.0], [wp[1] - 9.0, wp[1] + 5.0]),
+        RAIL_FILL,
+    );
+    // Hammer rest rail with its cushion.
+    let rx = g.rest_rail_x_mm;
+    let ry = g.rest_rail_top_y_mm;
+    part.polygon(rect(rx, [ry - 3.0 - 8.0, ry - 3.0]), RAIL_FILL);
+    part.polygon(rect(rx, [ry - 3.0, ry]), FELT_FILL);
+    part.label(
+        [0.5 * (rx[0] + rx[1]), ry - 9.0],
+        [0.0, 0.0],
+        "rest rail",
+        "middle",
+    );
+    // The string, seen from the side: a horizontal wire at its height.
+    let (sx, sy) = (g.string_x_mm, g.string_y_mm);
+    part.wire(vec![[sx[0], sy + 0.5], [sx[1], sy + 0.5]], 1.0, "#555555");
+    part.label(
+        [0.5 * (sx[0] + sx[1]), sy + 3.0],
+        [0.0, 0.0],
+        "string",
+        "middle",
+    );
+    part
+}
+
+/// Bounding box of the drawn points (mm).
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    min: P,
+    max: P,
+}
+
+impl Bounds {
+    fn new() -> Self {
+        Self {
+            min: [f64::INFINITY; 2],
+            max: [f64::NEG_INFINITY; 2],
+        }
+    }
+
+    fn add(&mut self, q: P, pad: f64) {
+        for ((lo, hi), v) in self.min.iter_mut().zip(&mut self.max).zip(q) {
+            *lo = lo.min(v - pad);
+            *hi = hi.max(v + pad);
+        }
+    }
+}
+
+/// Writes SVG elements with the y axis flipped (world mm, y up → SVG, y down).
+struct Svg {
+    body: String,
+    bounds: Bounds,
+}
+
+impl Svg {
+    fn pt(q: P) -> String {
+        format!("{:.2},{:.2}", q[0], -q[1])
+    }
+
+    fn polygon(&mut self, pts: &[P], attrs: &str) {
+        for &q in pts {
+            self.bounds.add(q, 0.0);
+        }
+        let s: Vec<String> = pts.iter().map(|&q| Self::pt(q)).collect();
+        let _ = writeln!(self.body, r#"<polygon points="{}" {attrs}/>"#, s.join(" "));
+    }
+
+    fn polyline(&mut self, pts: &[P], attrs: &str) {
+        for &q in pts {
+            self.bounds.add(q, 0.0);
+        }
+        let s: Vec<String> = pts.iter().map(|&q| Self::pt(q)).collect();
+        let _ = writeln!(
+            self.body,
+            r#"<polyline points="{}" fill="none" {attrs}/>"#,
+            s.join(" ")
+        );
+    }
+
+    fn circle(&mut self, c: P, r: f64, attrs: &str) {
+        self.bounds.add(c, r);
+        let _ = writeln!(
+            self.body,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="{:.2}" {attrs}/>"#,
+            c[0], -c[1], r
+        );
+    }
+
+    /// Text standing on `at` (its baseline 1 mm below, so it is centred on the point).
+    fn text(&mut self, at: P, text: &str, align: &str) {
+        let _ = writeln!(
+            self.body,
+            r#"<text x="{:.2}" y="{:.2}" text-anchor="{align}">{}</text>"#,
+            at[0],
+            -at[1] + 1.0,
+            escape(text)
+        );
+    }
+
+    fn open(&mut self, attrs: &str) {
+        let _ = writeln!(self.body, "<g {attrs}>");
+    }
+
+    fn close(&mut self) {
+        self.body.push_str("</g>\n");
+    }
+}
+
+/// Escapes text for SVG.
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// Maps a point (mm) by a pose in metres.
+fn map(x: &Transform, q: P) -> P {
+    mul(x.transform_point(mul(q, 1e-3)), 1e3)
+}
+
+/// Draws a contact shape placed in the world (m), thin.
+fn draw_shape(svg: &mut Svg, s: &Shape) {
+    let attrs = format!(r#"stroke="{CONTACT_STROKE}" stroke-width="0.25""#);
+    match s {
+        Shape::Circle(c) => svg.circle(
+            mul(c.center, 1e3),
+            c.radius * 1e3,
+            &format!(r#"fill="none" {attrs}"#),
+        ),
+        Shape::Segment(g) => svg.polyline(&[mul(g.a, 1e3), mul(g.b, 1e3)], &attrs),
+        Shape::Line(l) => {
+            let t = [-l.normal[1], l.normal[0]];
+            let p = mul(l.point, 1e3);
+            svg.polyline(&[sub(p, mul(t, 20.0)), add(p, mul(t, 20.0))], &attrs);
+        }
+        Shape::Arc(a) => svg.polyline(
+            &arc(
+                mul(a.center, 1e3),
+                a.radius * 1e3,
+                a.start,
+                a.start + a.sweep,
+            ),
+            &attrs,
+        ),
+    }
+}
+
+/// What the drawing needs of one contact at `(t, x)`: its shapes in the world (m), whether
+/// it is pressed and where.
+struct ContactView {
+    name: &'static str,
+    shapes: Vec<Shape>,
+    active: bool,
+    point: Option<P>,
+}
+
+/// Draws `action` to scale at time `t` and state `x` (a full state of `action.system`, as
+/// [`Action::layout_state`] or a solution row gives), titled `title`: an SVG document in
+/// millimetres.
+///
+/// Each body is an outline built from the parameters and placed by its world pose at
+/// `(t, x)` (the drive's value for a prescribed coordinate); bodies the model lacks are not
+/// drawn (the simplified model's jack is drawn as part of the wippen). Groups carry ids:
+/// `body-key`, `body-wippen`, `body-jack`, `body-repetition_lever`, `body-hammer`,
+/// `body-presser`, `fixed-parts`, `contact-<name>` for each contact's shapes (thin blue),
+/// and `active-<name>` for the red dot on each pressed contact (gap < 0), which the legend
+/// also lists.
+///
+/// Errors: a non-finite `t`, a state of the wrong length or with a non-finite entry.
+pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<String> {
+    if !t.is_finite() {
+        return Err(CoreError::NonFiniteInput {
+            what: "t",
+            index: 0,
+            value: t,
+        }
+        .into());
+    }
+    let system = &action.system;
+    let model = system.model();
+    let Some(&first) = action.contacts.values().next() else {
+        return Err(CoreError::UnknownName {
+            what: "contact",
+            name: "any (the action has none)".into(),
+        }
+        .into());
+    };
+
+    // Which bodies there are.
+    let is_body = |name: &str| model.body_id(name).is_ok();
+    let jack_moves = is_body("jack");
+    let with_lever = is_body("repetition_lever");
+    let with_presser = is_body("presser");
+
+    // Rest poses (q = 0, the layout) and current poses at (t, x) of every drawn frame.
+    let mut names = vec!["key", "wippen", "jack", "hammer"];
+    if with_lever {
+        names.push("repetition_lever");
+    }
+    if with_presser {
+        names.push("presser");
+    }
+    let mut rest_data = Data::new(model);
+    update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
+    let mut ws = system.workspace();
+    let mut carry: BTreeMap<&str, Transform> = BTreeMap::new();
+    let mut rest: BTreeMap<&str, Transform> = BTreeMap::new();
+    {
+        let ctx = system.element_context(&mut ws, t, x, first)?;
+        for name in &names {
+            let id = model.frame_id(name)?;
+            let x0 = frame_pose(model, &rest_data, id);
+            let x1 = frame_pose(model, ctx.data, id);
+            rest.insert(name, x0);
+            // Rest layout → now: X_now ∘ X_rest⁻¹.
+            carry.insert(name, x1.compose(&x0.inverse()));
+        }
+    }
+
+    // Contacts: shapes in the world, pressed or not, where.
+    let mut contacts = Vec::new();
+    for (&name, &e) in &action.contacts {
+        let gap = action.gap(name, t, x)?;
+        let ctx = system.element_context(&mut ws, t, x, e)?;
+        let contact = system.elements().nth(e).and_then(Contact::of);
+        let (shapes, point) = match contact {
+            Some(c) => {
+                let shapes = c
+                    .sides()
+                    .iter()
+                    .flat_map(|(body, shapes)| {
+                        let pose = ctx.body_pose(*body);
+                        shapes.iter().map(move |s| s.placed(&pose))
+                    })
+                    .collect();
+                (shapes, Some(mul(c.output(&ctx).point, 1e3)))
+            }
+            None => (Vec::new(), None),
+        };
+        contacts.push(ContactView {
+            name,
+            shapes,
+            active: gap < 0.0,
+            point,
+        });
+    }
+
+    // Parts, back to front.
+    let mut parts = vec![fixed_part(action), key_part(action)];
+    parts.push(wippen_part(action, !jack_moves, with_lever));
+    if with_lever {
+        parts.push(lever_part(action));
+    }
+    if jack_moves {
+        parts.push(jack_part(action));
+    }
+    if let Some(x0) = rest.get("hammer") {
+        parts.push(hammer_part(action, x0));
+    }
+    if action.contacts.contains_key("backcheck") {
+        parts.push(backcheck_part(action));
+    }
+    if let Some(x0) = rest.get("presser") {
+        parts.push(presser_part(x0));
+    }
+
+    let mut svg = Svg {
+        body: String::new(),
+        bounds: Bounds::new(),
+    };
+    let outline = r##"stroke="#333333" stroke-width="0.3" stroke-linejoin="round""##;
+    // Rest layout → now, for a part.
+    let carried = |part: &Part| {
+        part.frame
+            .and_then(|f| carry.get(f).copied())
+            .unwrap_or(Transform::IDENTITY)
+    };
+    for part in &parts {
+        let x_part = carried(part);
+        svg.open(&format!(r#"id="{}""#, part.id));
+        for (piece, fill) in &part.pieces {
+            match piece {
+                Outline::Polygon(pts) => {
+                    let pts: Vec<P> = pts.iter().map(|&q| map(&x_part, q)).collect();
+                    svg.polygon(&pts, &format!(r#"fill="{fill}" {outline}"#));
+                }
+                Outline::Circle(c, r) => {
+                    svg.circle(map(&x_part, *c), *r, &format!(r#"fill="{fill}" {outline}"#))
+                }
+                Outline::Wire(pts, width) => {
+                    let pts: Vec<P> = pts.iter().map(|&q| map(&x_part, q)).collect();
+                    svg.polyline(
+                        &pts,
+                        &format!(r#"stroke="{fill}" stroke-width="{width:.2}""#),
+                    );
+                }
+            }
+        }
+        for &pv in &part.pivots {
+            svg.circle(
+                map(&x_part, pv),
+                1.0,
+                r##"fill="#ffffff" stroke="#000000" stroke-width="0.3""##,
+            );
+        }
+        svg.close();
+    }
+    svg.open(r#"id="contact-shapes""#);
+    for c in &contacts {
+        svg.open(&format!(r#"id="contact-{}""#, c.name));
+        for s in &c.shapes {
+            draw_shape(&mut svg, s);
+        }
+        svg.close();
+    }
+    svg.close();
+    svg.open(r#"id="active-contacts""#);
+    for c in contacts.iter().filter(|c| c.active) {
+        if let Some(q) = c.point {
+            svg.circle(
+                q,
+                1.4,
+                &format!(
+                    r#"id="active-{}" fill="{ACTIVE_FILL}" stroke="none""#,
+                    c.name
+                ),
+            );
+        }
+    }
+    svg.close();
+    svg.open(r##"id="labels" font-size="3" fill="#222222""##);
+    for part in &parts {
+        let x_part = carried(part);
+        for l in &part.labels {
+            let a = map(&x_part, l.anchor);
+            let at = add(a, l.offset);
+            if l.offset != [0.0, 0.0] {
+                svg.polyline(&[a, at], r##"stroke="#555555" stroke-width="0.15""##);
+            }
+            svg.text(at, l.text, l.align);
+        }
+    }
+    svg.close();
+
+    Ok(frame_document(svg, &contacts, action.kind, title))
+}
+
+/// Wraps the drawing in its document: white page fitted around the action with a margin,
+/// title above, legend and scale bar below.
+fn frame_document(svg: Svg, contacts: &[ContactView], kind: ModelKind, title: &str) -> String {
+    let b = svg.bounds;
+    let (x0, x1) = (b.min[0] - MARGIN_MM, b.max[0] + MARGIN_MM);
+    // SVG y runs down: the top of the page is above the action's highest point.
+    let top = -b.max[1] - MARGIN_MM - TITLE_SPACE;
+    let bottom = -b.min[1] + MARGIN_MM + LEGEND_SPACE;
+    let (w, h) = (x1 - x0, bottom - top);
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.2}mm" height="{h:.2}mm" viewBox="{x0:.2} {top:.2} {w:.2} {h:.2}" font-family="sans-serif">"#
+    );
+    let _ = writeln!(
+        out,
+        r##"<rect x="{x0:.2}" y="{top:.2}" width="{w:.2}" height="{h:.2}" fill="#ffffff"/>"##
+    );
+    let _ = writeln!(
+        out,
+        r##"<text id="title" x="{:.2}" y="{:.2}" font-size="6" fill="#111111">{}</text>"##,
+        b.min[0],
+        -b.max[1] - TITLE_SPACE + 2.0,
+        escape(title)
+    );
+    out.push_str(&svg.body);
+
+    // Legend: pressed contacts, and what the thin lines are.
+    let active: Vec<&str> = contacts
+        .iter()
+        .filter(|c| c.active)
+        .map(|c| c.name)
+        .collect();
+    let y0 = -b.min[1] + MARGIN_MM;
+    let _ = writeln!(out, r##"<g id="legend" font-size="3.5" fill="#222222">"##);
+    let _ = writeln!(
+        out,
+        r#"<circle cx="{:.2}" cy="{:.2}" r="1.4" fill="{ACTIVE_FILL}"/>"#,
+        b.min[0] + 1.4,
+        y0 - 1.2
+    );
+    let list = if active.is_empty() {
+        "none".to_string()
+    } else {
+        active.join(", ")
+    };
+    let _ = writeln!(
+        out,
+        r#"<text x="{:.2}" y="{:.2}">contacts pressed: {}</text>"#,
+        b.min[0] + 4.5,
+        y0,
+        escape(&list)
+    );
+    let _ = writeln!(
+        out,
+        r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="{CONTACT_STROKE}" stroke-width="0.25"/>"#,
+        b.min[0],
+        y0 + 4.8,
+        b.min[0] + 3.0,
+        y0 + 4.8
+    );
+    let _ = writeln!(
+        out,
+        r#"<text x="{:.2}" y="{:.2}">contact shapes of the {} model; white dots: pivots</text>"#,
+        b.min[0] + 4.5,
+        y0 + 6.0,
+        kind.name()
+    );
+    out.push_str("</g>\n");
+
+    // Scale bar at the bottom right.
+    let (sx1, sy) = (b.max[0], y0 + 4.0);
+    let sx0 = sx1 - SCALE_BAR_MM;
+    let _ = writeln!(
+        out,
+        r##"<g id="scale-bar" stroke="#000000" stroke-width="0.4"><line x1="{sx0:.2}" y1="{sy:.2}" x2="{sx1:.2}" y2="{sy:.2}"/><line x1="{sx0:.2}" y1="{:.2}" x2="{sx0:.2}" y2="{:.2}"/><line x1="{sx1:.2}" y1="{:.2}" x2="{sx1:.2}" y2="{:.2}"/><text x="{:.2}" y="{:.2}" font-size="3.5" stroke="none" fill="#000000" text-anchor="middle">{SCALE_BAR_MM} mm</text></g>"##,
+        sy - 1.2,
+        sy + 1.2,
+        sy - 1.2,
+        sy + 1.2,
+        0.5 * (sx0 + sx1),
+        sy - 2.0
+    );
+    out.push_str("</svg>\n");
+    out
+}
