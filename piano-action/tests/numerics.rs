@@ -30,19 +30,19 @@ fn default_tolerances_give_the_same_blows_as_tight_ones() {
         let (sa, sb) = (a.strikes[0], b.strikes[0]);
         eprintln!("{input:?}\n  default {sa:?}\n  tight   {sb:?}");
         assert!(
-            (sa.hammer_velocity_m_s / sb.hammer_velocity_m_s - 1.0).abs() < 1e-4,
+            (sa.hammer_velocity_m_s / sb.hammer_velocity_m_s - 1.0).abs() < 1e-3,
             "hammer speed {} vs {}",
             sa.hammer_velocity_m_s,
             sb.hammer_velocity_m_s
         );
         assert!(
-            (sa.time_s - sb.time_s).abs() < 1e-6,
+            (sa.time_s - sb.time_s).abs() < 5e-6,
             "strike {} vs {}",
             sa.time_s,
             sb.time_s
         );
         let (la, lb) = (a.let_off_time_s.unwrap(), b.let_off_time_s.unwrap());
-        assert!((la - lb).abs() < 1e-6, "let-off {la} vs {lb}");
+        assert!((la - lb).abs() < 5e-6, "let-off {la} vs {lb}");
         // And the loose run does much less work.
         assert!(
             a.solution.stats.steps * 2 < b.solution.stats.steps,
