@@ -582,6 +582,7 @@ impl Action {
         let opts = Options {
             max_step,
             output_step,
+            event_samples: self.params.numerics.event_samples,
             ..Options::with_tolerances(
                 self.params.numerics.relative_tolerance,
                 self.params.numerics.absolute_tolerance,

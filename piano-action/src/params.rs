@@ -259,6 +259,9 @@ pub struct NumericsParams {
     pub relative_tolerance: f64,
     /// Absolute error tolerance of the integrator (rad, m, rad/s, m/s).
     pub absolute_tolerance: f64,
+    /// Points per step at which the contacts' gaps are checked for onsets and releases
+    /// (at least 1).
+    pub event_samples: usize,
 }
 
 /// The whole parameter set.
@@ -345,6 +348,12 @@ impl ActionParams {
                 self.numerics.absolute_tolerance,
             ),
         ];
+        if self.numerics.event_samples == 0 {
+            return Err(PianoError::Params {
+                field: "numerics.event_samples".into(),
+                message: "must be at least 1".into(),
+            });
+        }
         for (field, v) in positive {
             if v <= 0.0 {
                 return Err(PianoError::Params {
