@@ -162,7 +162,11 @@ impl Contact {
     /// Gap, forces and power at the state in `ctx`; `rates` receives the normal law's state
     /// rates.
     fn compute(&self, ctx: &ForceContext<'_>, rates: &mut [f64]) -> ContactOutput {
-        let p = self.proximity(ctx);
+        self.compute_at(self.proximity(ctx), ctx, rates)
+    }
+
+    /// [`Contact::compute`] with the proximity already found.
+    fn compute_at(&self, p: Proximity, ctx: &ForceContext<'_>, rates: &mut [f64]) -> ContactOutput {
         let mid = [
             0.5 * (p.point_a[0] + p.point_b[0]),
             0.5 * (p.point_a[1] + p.point_b[1]),
@@ -312,7 +316,13 @@ impl ForceElement for Contact {
     }
 
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, rates: &mut [f64]) {
-        let out = self.compute(ctx, rates);
+        let p = self.proximity(ctx);
+        // Apart, a memoryless law gives no force (laws never pull: 0 whenever δ ≤ 0), so
+        // the velocities and the law need not be evaluated.
+        if p.gap >= 0.0 && self.normal.state_count() == 0 {
+            return;
+        }
+        let out = self.compute_at(p, ctx, rates);
         if !out.active {
             return;
         }

@@ -51,6 +51,11 @@ pub struct Segment {
     pub a: [f64; 2],
     /// End.
     pub b: [f64; 2],
+    /// Unit direction from `a` to `b` (kept so placing a segment rotates it rather than
+    /// taking a square root at every evaluation).
+    u: [f64; 2],
+    /// Length.
+    len: f64,
 }
 
 /// Which side of an arc is the surface.
@@ -140,7 +145,14 @@ impl Shape {
                 message: format!("zero length: a = {a:?}, b = {b:?}"),
             });
         }
-        Ok(Shape::Segment(Segment { a, b }))
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len = d[0].hypot(d[1]);
+        Ok(Shape::Segment(Segment {
+            a,
+            b,
+            u: [d[0] / len, d[1] / len],
+            len,
+        }))
     }
 
     /// An arc; radius positive, sweep in (0, 2π].
@@ -184,6 +196,8 @@ impl Shape {
             Shape::Segment(s) => Shape::Segment(Segment {
                 a: pose.transform_point(s.a),
                 b: pose.transform_point(s.b),
+                u: pose.rotate(s.u),
+                len: s.len,
             }),
             Shape::Arc(a) => Shape::Arc(Arc {
                 center: pose.transform_point(a.center),
@@ -290,11 +304,9 @@ fn face_round(
 
 /// Unit direction and length of a segment.
 fn seg_frame(s: &Segment) -> ([f64; 2], f64, [f64; 2]) {
-    let d = sub(s.b, s.a);
-    let len = norm(d);
-    let u = [d[0] / len, d[1] / len];
+    let u = s.u;
     // Outward normal: the direction turned a quarter counter-clockwise (faces left).
-    (u, len, [-u[1], u[0]])
+    (u, s.len, [-u[1], u[0]])
 }
 
 /// Whether angle `phi` lies in the arc's span.
