@@ -194,12 +194,12 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
         .collect();
     let failed = rows.iter().filter(|r| r.run.is_err()).count();
     println!(
-        "{} {} runs of {} s on {} threads in {wall:.1} s wall ({:.2} s per run)",
+        "{} {} runs of {} s on {} threads in {wall:.1} s wall ({:.1} ms per run)",
         values.len(),
         kind.name(),
         a.duration,
         pool.current_num_threads(),
-        wall / values.len() as f64
+        wall * 1e3 / values.len() as f64
     );
     if let (Some(min), Some(max)) = (
         speeds.iter().copied().reduce(f64::min),
