@@ -744,7 +744,6 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         .into());
     }
     let system = &action.system;
-    let model = system.model();
     let Some(&first) = action.contacts.values().next() else {
         return Err(CoreError::UnknownName {
             what: "contact",
@@ -753,36 +752,8 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         .into());
     };
 
-    // Which bodies there are.
-    let is_body = |name: &str| model.body_id(name).is_ok();
-    let jack_moves = is_body("jack");
-    let with_lever = is_body("repetition_lever");
-    let with_presser = is_body("presser");
-
-    // Rest poses (q = 0, the layout) and current poses at (t, x) of every drawn frame.
-    let mut names = vec!["key", "wippen", "jack", "hammer"];
-    if with_lever {
-        names.push("repetition_lever");
-    }
-    if with_presser {
-        names.push("presser");
-    }
-    let mut rest_data = Data::new(model);
-    update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
+    let (rest, carry) = rest_and_carry(action, t, x, first)?;
     let mut ws = system.workspace();
-    let mut carry: BTreeMap<&str, Transform> = BTreeMap::new();
-    let mut rest: BTreeMap<&str, Transform> = BTreeMap::new();
-    {
-        let ctx = system.element_context(&mut ws, t, x, first)?;
-        for name in &names {
-            let id = model.frame_id(name)?;
-            let x0 = frame_pose(model, &rest_data, id);
-            let x1 = frame_pose(model, ctx.data, id);
-            rest.insert(name, x0);
-            // Rest layout → now: X_now ∘ X_rest⁻¹.
-            carry.insert(name, x1.compose(&x0.inverse()));
-        }
-    }
 
     // Contacts: shapes in the world, pressed or not, where.
     let mut contacts = Vec::new();
@@ -812,24 +783,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         });
     }
 
-    // Parts, back to front.
-    let mut parts = vec![fixed_part(action), key_part(action)];
-    parts.push(wippen_part(action, !jack_moves, with_lever));
-    if with_lever {
-        parts.push(lever_part(action));
-    }
-    if jack_moves {
-        parts.push(jack_part(action));
-    }
-    if let Some(x0) = rest.get("hammer") {
-        parts.push(hammer_part(action, x0));
-    }
-    if action.contacts.contains_key("backcheck") {
-        parts.push(backcheck_part(action));
-    }
-    if let Some(x0) = rest.get("presser") {
-        parts.push(presser_part(x0));
-    }
+    let parts = build_parts(action, &rest);
 
     let mut svg = Svg {
         body: String::new(),
@@ -997,4 +951,207 @@ fn frame_document(svg: Svg, contacts: &[ContactView], kind: ModelKind, title: &s
     );
     out.push_str("</svg>\n");
     out
+}
+
+/// The frames a drawing carries, in drawing order.
+fn drawn_frames(action: &Action) -> Vec<&'static str> {
+    let model = action.system.model();
+    let mut names = vec!["key", "wippen", "jack", "hammer"];
+    for extra in ["repetition_lever", "presser"] {
+        if model.body_id(extra).is_ok() {
+            names.push(extra);
+        }
+    }
+    names
+}
+
+/// Rest poses (q = 0, the layout) of every drawn frame, and the motion carrying each from
+/// its rest place to where it is at `(t, x)` (`X_now ∘ X_rest⁻¹`), computed through element
+/// `element`'s context (so a prescribed coordinate takes its drive's value).
+#[allow(clippy::type_complexity)]
+fn rest_and_carry(
+    action: &Action,
+    t: f64,
+    x: &[f64],
+    element: usize,
+) -> Result<(
+    BTreeMap<&'static str, Transform>,
+    BTreeMap<&'static str, Transform>,
+)> {
+    let system = &action.system;
+    let model = system.model();
+    let mut rest_data = Data::new(model);
+    update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
+    let mut ws = system.workspace();
+    let mut carry = BTreeMap::new();
+    let mut rest = BTreeMap::new();
+    let ctx = system.element_context(&mut ws, t, x, element)?;
+    for name in drawn_frames(action) {
+        let id = model.frame_id(name)?;
+        let x0 = frame_pose(model, &rest_data, id);
+        let x1 = frame_pose(model, ctx.data, id);
+        rest.insert(name, x0);
+        carry.insert(name, x1.compose(&x0.inverse()));
+    }
+    Ok((rest, carry))
+}
+
+/// The parts of `action`, back to front, in their rest places.
+fn build_parts(action: &Action, rest: &BTreeMap<&'static str, Transform>) -> Vec<Part> {
+    let model = action.system.model();
+    let is_body = |name: &str| model.body_id(name).is_ok();
+    let jack_moves = is_body("jack");
+    let with_lever = is_body("repetition_lever");
+    let mut parts = vec![fixed_part(action), key_part(action)];
+    parts.push(wippen_part(action, !jack_moves, with_lever));
+    if with_lever {
+        parts.push(lever_part(action));
+    }
+    if jack_moves {
+        parts.push(jack_part(action));
+    }
+    if let Some(x0) = rest.get("hammer") {
+        parts.push(hammer_part(action, x0));
+    }
+    if action.contacts.contains_key("backcheck") {
+        parts.push(backcheck_part(action));
+    }
+    if let Some(x0) = rest.get("presser") {
+        parts.push(presser_part(x0));
+    }
+    parts
+}
+
+fn round(v: f64) -> f64 {
+    (v * 1e3).round() / 1e3
+}
+
+fn json_points(pts: &[P]) -> serde_json::Value {
+    pts.iter()
+        .map(|q| serde_json::json!([round(q[0]), round(q[1])]))
+        .collect()
+}
+
+/// The drawing as data, for a viewer that moves it (the report): every part's outlines in
+/// its rest place (mm, world, y up) with the frame that carries it (`null`: fixed), pivots
+/// and labels; and every contact's shapes in their rest places, each with the frame of its
+/// side. Move a part by its frame's [`carry`] transform.
+pub fn scene(action: &Action) -> Result<serde_json::Value> {
+    let (rest, _) = {
+        let x = action.layout_state()?;
+        let first =
+            action
+                .contacts
+                .values()
+                .next()
+                .copied()
+                .ok_or_else(|| CoreError::UnknownName {
+                    what: "contact",
+                    name: "any (the action has none)".into(),
+                })?;
+        rest_and_carry(action, 0.0, &x, first)?
+    };
+    let parts: Vec<serde_json::Value> = build_parts(action, &rest)
+        .iter()
+        .map(|part| {
+            let pieces: Vec<serde_json::Value> = part
+                .pieces
+                .iter()
+                .map(|(piece, fill)| match piece {
+                    Outline::Polygon(pts) => {
+                        serde_json::json!({"kind": "polygon", "pts": json_points(pts), "fill": fill})
+                    }
+                    Outline::Circle(c, r) => serde_json::json!({
+                        "kind": "circle", "c": [round(c[0]), round(c[1])], "r": round(*r), "fill": fill
+                    }),
+                    Outline::Wire(pts, w) => serde_json::json!({
+                        "kind": "wire", "pts": json_points(pts), "width": round(*w), "fill": fill
+                    }),
+                })
+                .collect();
+            let labels: Vec<serde_json::Value> = part
+                .labels
+                .iter()
+                .map(|l| {
+                    serde_json::json!({
+                        "anchor": [round(l.anchor[0]), round(l.anchor[1])],
+                        "offset": l.offset, "text": l.text, "align": l.align
+                    })
+                })
+                .collect();
+            serde_json::json!({
+                "id": part.id,
+                "frame": part.frame,
+                "pieces": pieces,
+                "pivots": json_points(&part.pivots),
+                "labels": labels,
+            })
+        })
+        .collect();
+    // Contact shapes in their rest places (mm), by side.
+    let model = action.system.model();
+    let mut contacts = Vec::new();
+    let mut rest_data = Data::new(model);
+    update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
+    for (&name, &e) in &action.contacts {
+        let Some(c) = action.system.elements().nth(e).and_then(Contact::of) else {
+            continue;
+        };
+        let mut sides = Vec::new();
+        for (body, shapes) in c.sides() {
+            let frame = if body == mbs_core::BodyId::GROUND {
+                None
+            } else {
+                Some(model.body_name(body).to_string())
+            };
+            let pose = rest_data.body_pose(body);
+            let placed: Vec<serde_json::Value> = shapes
+                .iter()
+                .map(|s| match s.placed(&pose) {
+                    Shape::Circle(c) => serde_json::json!({
+                        "kind": "circle",
+                        "c": [round(c.center[0] * 1e3), round(c.center[1] * 1e3)],
+                        "r": round(c.radius * 1e3)
+                    }),
+                    Shape::Segment(g) => serde_json::json!({
+                        "kind": "segment", "pts": json_points(&[mul(g.a, 1e3), mul(g.b, 1e3)])
+                    }),
+                    Shape::Line(l) => serde_json::json!({
+                        "kind": "line", "point": json_points(&[mul(l.point, 1e3)]), "normal": l.normal
+                    }),
+                    Shape::Arc(a) => serde_json::json!({
+                        "kind": "arc",
+                        "c": [round(a.center[0] * 1e3), round(a.center[1] * 1e3)],
+                        "r": round(a.radius * 1e3), "start": a.start, "sweep": a.sweep
+                    }),
+                })
+                .collect();
+            sides.push(serde_json::json!({"frame": frame, "shapes": placed}));
+        }
+        contacts.push(serde_json::json!({"name": name, "sides": sides}));
+    }
+    Ok(serde_json::json!({
+        "frames": drawn_frames(action),
+        "parts": parts,
+        "contacts": contacts,
+    }))
+}
+
+/// For every drawn frame, the motion `[angle (rad), x (mm), y (mm)]` carrying its parts from
+/// their rest places to where they are at `(t, x)` (see [`scene`]).
+pub fn carry(action: &Action, t: f64, x: &[f64]) -> Result<Vec<(&'static str, [f64; 3])>> {
+    let first = action
+        .contacts
+        .values()
+        .next()
+        .copied()
+        .ok_or_else(|| CoreError::UnknownName {
+            what: "contact",
+            name: "any (the action has none)".into(),
+        })?;
+    let (_, carry) = rest_and_carry(action, t, x, first)?;
+    Ok(drawn_frames(action)
+        .into_iter()
+        .filter_map(|f| carry.get(f).map(|c| (f, [c.angle(), c.x * 1e3, c.y * 1e3])))
+        .collect())
 }

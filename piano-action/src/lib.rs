@@ -23,6 +23,7 @@ mod error;
 pub mod params;
 pub mod pendulum;
 pub mod regulation;
+pub mod report;
 pub mod scenario;
 pub mod simulate;
 pub mod sweep;

@@ -34,6 +34,20 @@ enum Command {
         /// Output directory.
         #[arg(long)]
         out: std::path::PathBuf,
+        /// Also write the interactive report, DIR/report.html.
+        #[arg(long)]
+        report: bool,
+    },
+    /// Write the interactive report of one or more run directories: one self-contained
+    /// HTML page replaying them in slow motion, to scale, with contact forces, events and
+    /// linked plots.
+    Report {
+        /// Run directories written by `piano simulate`.
+        #[arg(required = true)]
+        runs: Vec<std::path::PathBuf>,
+        /// The HTML file to write (default: report.html in the first run directory).
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
     },
     /// Write the default parameter file (with its comments and sources) to standard output.
     Params,
@@ -95,10 +109,18 @@ enum Command {
     },
 }
 
+/// Writes the report of `runs` to `out` and prints its path.
+fn write_report(runs: &[std::path::PathBuf], out: &std::path::Path) -> Result<(), String> {
+    piano_action::report::write_report(runs, out).map_err(|e| e.to_string())?;
+    println!("report: {}", out.display());
+    Ok(())
+}
+
 fn simulate_scenario(
     params: &ActionParams,
     path: &std::path::Path,
     out: &std::path::Path,
+    report: bool,
 ) -> Result<(), String> {
     use piano_action::scenario::{InputSpec, Scenario, write_pendulum_dir, write_run_dir};
     let scenario = Scenario::load(path).map_err(|e| e.to_string())?;
@@ -112,6 +134,9 @@ fn simulate_scenario(
             scenario.duration_s
         );
         println!("run directory: {}", out.display());
+        if report {
+            println!("(a pendulum run has no report: its summary.json has the swing)");
+        }
         return Ok(());
     }
     let run = scenario.run(params).map_err(|e| e.to_string())?;
@@ -125,6 +150,9 @@ fn simulate_scenario(
         );
     }
     println!("run directory: {}", out.display());
+    if report {
+        write_report(&[out.to_path_buf()], &out.join("report.html"))?;
+    }
     Ok(())
 }
 
@@ -411,7 +439,15 @@ fn main() -> ExitCode {
             Command::Regulate { model, json, write } => {
                 regulate(&params, &model, json, write.as_deref())
             }
-            Command::Simulate { scenario, out } => simulate_scenario(&params, &scenario, &out),
+            Command::Simulate {
+                scenario,
+                out,
+                report,
+            } => simulate_scenario(&params, &scenario, &out, report),
+            Command::Report { runs, out } => {
+                let out = out.unwrap_or_else(|| runs[0].join("report.html"));
+                write_report(&runs, &out)
+            }
             Command::Sweep {
                 touch,
                 from,

@@ -1,0 +1,388 @@
+//! The interactive report: one self-contained HTML file (no network, works from `file://`)
+//! that replays one or more run directories in slow motion, with the action drawn to scale,
+//! the contact forces as arrows, the events on a timeline and linked plots.
+//!
+//! The data are read from the run directory: `run.json` (scenario and parameters, from
+//! which the action is rebuilt for its geometry and kinematics), `trajectory.csv` (the
+//! coordinates and velocities on the output grid), `events.json` and `summary.json`.
+//! Everything the page shows is computed here and embedded as JSON; the page only draws.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+
+use crate::action::ModelKind;
+use crate::error::{PianoError, Result};
+use crate::params::ActionParams;
+use crate::scenario::{InputSpec, Scenario};
+use crate::simulate::{Prepared, key_depth_mm, prepare};
+
+const STYLE: &str = include_str!("report/report.css");
+/// The `generator` of every report page: a file that lacks it is not overwritten.
+pub const GENERATOR: &str = "piano report";
+const SCRIPT: &str = include_str!("report/report.js");
+
+fn bad(dir: &Path, message: String) -> PianoError {
+    PianoError::Params {
+        field: String::new(),
+        message: format!("{}: {message}", dir.display()),
+    }
+}
+
+fn read(dir: &Path, name: &str) -> Result<String> {
+    std::fs::read_to_string(dir.join(name))
+        .map_err(|e| bad(dir, format!("cannot read {name}: {e}")))
+}
+
+fn read_json(dir: &Path, name: &str) -> Result<Value> {
+    serde_json::from_str(&read(dir, name)?).map_err(|e| bad(dir, format!("{name}: {e}")))
+}
+
+/// Rounds `v` to `digits` decimals (keeps the embedded data small).
+fn r(v: f64, digits: i32) -> f64 {
+    let s = 10f64.powi(digits);
+    let out = (v * s).round() / s;
+    if out == 0.0 { 0.0 } else { out }
+}
+
+/// The rows of `trajectory.csv`: column names and values.
+fn read_trajectory(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let text = read(dir, "trajectory.csv")?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .ok_or_else(|| bad(dir, "trajectory.csv is empty".into()))?
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let mut rows = Vec::new();
+    for (i, line) in lines.enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let row: std::result::Result<Vec<f64>, _> = line.split(',').map(str::parse).collect();
+        let row = row.map_err(|e| bad(dir, format!("trajectory.csv line {}: {e}", i + 2)))?;
+        if row.len() != header.len() || row.iter().any(|v| !v.is_finite()) {
+            return Err(bad(
+                dir,
+                format!(
+                    "trajectory.csv line {}: expected {} finite numbers",
+                    i + 2,
+                    header.len()
+                ),
+            ));
+        }
+        rows.push(row);
+    }
+    if rows.is_empty() {
+        return Err(bad(dir, "trajectory.csv has no rows".into()));
+    }
+    Ok((header, rows))
+}
+
+/// A short description of a scenario's input, for titles and legends.
+fn describe(input: &InputSpec) -> String {
+    match input {
+        InputSpec::Force {
+            force_n: Some(f), ..
+        } => format!("force {f} N"),
+        InputSpec::Force { .. } => "force table".into(),
+        InputSpec::MassDrop { mass_kg, height_m } => {
+            format!("{mass_kg} kg dropped from {} mm", height_m * 1e3)
+        }
+        InputSpec::Pendulum { release_angle_deg } => format!("pendulum {release_angle_deg}°"),
+        InputSpec::Motion { .. } => "key motion".into(),
+        InputSpec::Touch {
+            peak_force_n: Some(f),
+            ..
+        } => format!("pressed touch {f} N"),
+        InputSpec::Touch {
+            finger_speed_m_s: Some(v),
+            ..
+        } => format!("struck touch {v} m/s"),
+        InputSpec::Touch { .. } => "touch".into(),
+    }
+}
+
+/// The report data of one run directory (see the module docs).
+pub fn run_data(dir: &Path) -> Result<Value> {
+    let run = read_json(dir, "run.json")?;
+    let scenario: Scenario = serde_json::from_value(run["scenario"].clone())
+        .map_err(|e| bad(dir, format!("run.json scenario: {e}")))?;
+    let params: ActionParams = serde_json::from_value(run["params"].clone())
+        .map_err(|e| bad(dir, format!("run.json params: {e}")))?;
+    params.validate()?;
+    if matches!(scenario.input, InputSpec::Pendulum { .. }) {
+        return Err(bad(
+            dir,
+            "a pendulum run has no keystroke to replay (its summary.json has the swing)".into(),
+        ));
+    }
+    let kind: ModelKind = scenario.model_kind()?;
+    let Prepared {
+        action,
+        x0,
+        rest_depth_mm,
+    } = prepare(&params, kind, &scenario.input.to_input()?)?;
+    let model = action.system.model();
+    let nv = model.nv();
+    let names = model.coordinate_names().to_vec();
+    let (header, rows) = read_trajectory(dir)?;
+    for (i, n) in names.iter().enumerate() {
+        let (q, v) = (format!("{n}_q"), format!("{n}_v"));
+        if header.get(1 + i) != Some(&q) || header.get(1 + nv + i) != Some(&v) {
+            return Err(bad(
+                dir,
+                format!(
+                    "trajectory.csv columns do not match the {} model",
+                    kind.name()
+                ),
+            ));
+        }
+    }
+    let drive_col = header.iter().position(|h| h == "key_drive_force_n");
+    let key = model.coordinate_id("key")?;
+    let hammer = model.coordinate_id("hammer")?;
+    let strike_radius_m = {
+        let s = params.hammer.strike_body_mm;
+        s[0].hypot(s[1]) * 1e-3
+    };
+
+    let frames = crate::drawing::scene(&action)?;
+    let frame_names: Vec<&str> = frames["frames"]
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    let contact_names: Vec<&'static str> = action.contacts.keys().copied().collect();
+
+    let n = rows.len();
+    let mut t = Vec::with_capacity(n);
+    let mut carry: Vec<[Vec<f64>; 3]> = vec![Default::default(); frame_names.len()];
+    let mut forces: Vec<[Vec<f64>; 5]> = vec![Default::default(); contact_names.len()];
+    let mut series: Vec<(&str, &str, Vec<f64>)> = vec![
+        ("hammer_angle_deg", "hammer angle (°)", Vec::new()),
+        (
+            "hammer_speed_m_s",
+            "hammer speed at the strike point (m/s)",
+            Vec::new(),
+        ),
+        (
+            "key_depth_mm",
+            "key-front depth below rest (mm)",
+            Vec::new(),
+        ),
+        ("kinetic_mj", "kinetic energy (mJ)", Vec::new()),
+        (
+            "gravity_mj",
+            "gravitational energy from rest (mJ)",
+            Vec::new(),
+        ),
+    ];
+    if drive_col.is_some() {
+        series.push((
+            "key_drive_force_n",
+            "hand force at the key front (N)",
+            Vec::new(),
+        ));
+    }
+    let mut ws = action.system.workspace();
+    let mut potential0 = None;
+    let mut x = x0.clone();
+    for row in &rows {
+        let time = row[0];
+        x[..2 * nv].copy_from_slice(&row[1..1 + 2 * nv]);
+        t.push(r(time, 6));
+        let c = crate::drawing::carry(&action, time, &x)?;
+        for (slot, (_, m)) in carry.iter_mut().zip(&c) {
+            slot[0].push(r(m[0], 6));
+            slot[1].push(r(m[1], 3));
+            slot[2].push(r(m[2], 3));
+        }
+        for (slot, name) in forces.iter_mut().zip(&contact_names) {
+            let o = action.contact_output(name, time, &x)?;
+            let on = o.active && o.normal_force > 0.0;
+            let f = if on { o.normal_force } else { 0.0 };
+            slot[0].push(r(f, 3));
+            for (k, v) in [o.point[0] * 1e3, o.point[1] * 1e3, o.normal[0], o.normal[1]]
+                .into_iter()
+                .enumerate()
+            {
+                slot[1 + k].push(if on {
+                    r(v, if k < 2 { 2 } else { 3 })
+                } else {
+                    0.0
+                });
+            }
+        }
+        let e = action.system.energy(&mut ws, time, &x)?;
+        // The elastic energy is left out: under a touch it holds the arm's work (a preload),
+        // which would swamp the action's own.
+        let p0 = *potential0.get_or_insert(e.gravity);
+        let values = [
+            x[hammer].to_degrees(),
+            x[nv + hammer] * strike_radius_m,
+            key_depth_mm(&params, x[key]) - rest_depth_mm,
+            e.kinetic * 1e3,
+            (e.gravity - p0) * 1e3,
+        ];
+        for (s, v) in series.iter_mut().zip(values) {
+            s.2.push(r(v, 4));
+        }
+        if let (Some(col), Some(s)) = (drive_col, series.get_mut(5)) {
+            s.2.push(r(row[col], 3));
+        }
+    }
+
+    // Where millimetres matter: the contacts that set the regulation, at rest.
+    let mut zoom = serde_json::Map::new();
+    for (label, contact, half) in [
+        ("let-off", "let_off_button", 18.0),
+        ("jack and knuckle", "jack_knuckle", 18.0),
+        ("string", "hammer_string", 25.0),
+        ("backcheck", "backcheck", 25.0),
+        ("capstan", "capstan_heel", 18.0),
+    ] {
+        if action.contacts.contains_key(contact) {
+            let p = action.contact_output(contact, 0.0, &x0)?.point;
+            zoom.insert(
+                label.into(),
+                json!({"center": [r(p[0] * 1e3, 2), r(p[1] * 1e3, 2)], "half_width": half}),
+            );
+        }
+    }
+
+    let carry_json: serde_json::Map<String, Value> = frame_names
+        .iter()
+        .zip(carry)
+        .map(|(f, [a, x, y])| (f.to_string(), json!({"a": a, "x": x, "y": y})))
+        .collect();
+    let forces_json: serde_json::Map<String, Value> = contact_names
+        .iter()
+        .zip(forces)
+        .map(|(c, [f, px, py, nx, ny])| {
+            (
+                c.to_string(),
+                json!({"f": f, "px": px, "py": py, "nx": nx, "ny": ny}),
+            )
+        })
+        .collect();
+    let series_json: Vec<Value> = series
+        .into_iter()
+        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
+        .collect();
+    let name = dir
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string());
+    Ok(json!({
+        "name": name,
+        "title": format!("{} action, {}", kind.name(), describe(&scenario.input)),
+        "model": kind.name(),
+        "scene": frames,
+        "t": t,
+        "carry": carry_json,
+        "contacts": forces_json,
+        "series": series_json,
+        "events": read_json(dir, "events.json")?,
+        "summary": read_json(dir, "summary.json")?,
+        "zoom": zoom,
+    }))
+}
+
+/// Embeds `value` as JSON inside a `<script>` element: `</` is escaped so no string in the
+/// data can close the element.
+fn embed(value: &Value) -> String {
+    value.to_string().replace("</", "<\\/")
+}
+
+fn escape_html(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The report page of the runs in `dirs` (at least one), as one self-contained HTML string.
+pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
+    if dirs.is_empty() {
+        return Err(PianoError::Params {
+            field: "RUN_DIR".into(),
+            message: "give at least one run directory".into(),
+        });
+    }
+    let runs: Vec<Value> = dirs.iter().map(|d| run_data(d)).collect::<Result<_>>()?;
+    let title = runs
+        .iter()
+        .filter_map(|r| r["title"].as_str())
+        .collect::<Vec<_>>()
+        .join(" · ");
+    let data = json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "runs": runs,
+    });
+    let mut html = String::new();
+    let _ = write!(
+        html,
+        r#"<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="{GENERATOR}">
+<title>{}</title>
+<style>
+{STYLE}
+</style>
+</head>
+<body>
+<script type="application/json" id="report-data">{}</script>
+<script>
+{SCRIPT}
+</script>
+</body>
+</html>
+"#,
+        escape_html(&format!("Piano action report: {title}")),
+        embed(&data)
+    );
+    Ok(html)
+}
+
+/// Writes the report of `dirs` to `out`. An existing `out` is replaced only if it is itself
+/// a report (its `generator` is [`GENERATOR`]); anything else is left alone, with an error.
+pub fn write_report(dirs: &[PathBuf], out: &Path) -> Result<()> {
+    if out.exists() {
+        let ours = std::fs::read_to_string(out)
+            .map(|t| t.contains(&format!(r#"<meta name="generator" content="{GENERATOR}">"#)))
+            .unwrap_or(false);
+        if !ours {
+            return Err(PianoError::Params {
+                field: "--out".into(),
+                message: format!(
+                    "{} exists and is not a piano report; choose another file",
+                    out.display()
+                ),
+            });
+        }
+    }
+    let html = report_html(dirs)?;
+    std::fs::write(out, html).map_err(|e| PianoError::Params {
+        field: String::new(),
+        message: format!("cannot write {}: {e}", out.display()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_json_cannot_close_its_script_element() {
+        let v = json!({"name": "</script><script>alert(1)</script>"});
+        let text = embed(&v);
+        assert!(!text.contains("</"), "{text}");
+        let back: Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, v);
+    }
+}

@@ -1,0 +1,523 @@
+// The piano action report: replays the embedded runs in slow motion. Everything it shows
+// was computed by `piano report`; this script only draws. No network, no libraries.
+(function () {
+  'use strict';
+
+  const DATA = JSON.parse(document.getElementById('report-data').textContent);
+  const RUNS = DATA.runs;
+  const RUN_COLORS = ['#1f4e9c', '#c0392b', '#2e8b57', '#8e44ad', '#d35400', '#555555'];
+  const CONTACT_COLORS = {
+    hammer_string: '#c0392b', capstan_heel: '#2e8b57', jack_knuckle: '#8e44ad',
+    lever_knuckle: '#2980b9', front_rail: '#d35400', back_rail: '#7f8c8d',
+    let_off_button: '#16a085', drop_screw: '#34495e', backcheck: '#b7950b',
+    rest_rail: '#95a5a6', presser_key: '#555555',
+  };
+  const SPEEDS = [
+    ['1/1000', 0.001], ['1/300', 1 / 300], ['1/100', 0.01], ['1/30', 1 / 30],
+    ['1/10', 0.1], ['1/3', 1 / 3], ['real time', 1],
+  ];
+  // Arrow length (mm) for a force f (N): logarithmic, so 0.1 N and 100 N both read.
+  const ARROW_MM_PER_DECADE = 6;
+  const arrowMm = (f, gain) => gain * ARROW_MM_PER_DECADE * Math.log10(1 + f / 0.1);
+
+  const tStart = Math.min(...RUNS.map((r) => r.t[0]));
+  const tEnd = Math.max(...RUNS.map((r) => r.t[r.t.length - 1]));
+  const frameDt = Math.min(...RUNS.map((r) => (r.t.length > 1 ? r.t[1] - r.t[0] : 1e-3)));
+
+  const state = { t: tStart, playing: false, speed: 0.01, loop: false, gain: 1, last: null };
+
+  // ---------------------------------------------------------------- helpers
+  function el(tag, attrs, parent, text) {
+    const e = document.createElement(tag);
+    for (const [k, v] of Object.entries(attrs || {})) {
+      if (k === 'class') e.className = v; else e.setAttribute(k, v);
+    }
+    if (text !== undefined) e.textContent = text;
+    if (parent) parent.appendChild(e);
+    return e;
+  }
+  const clamp = (x, a, b) => Math.min(b, Math.max(a, x));
+  const fmtMs = (t) => (t * 1e3).toFixed(2) + ' ms';
+
+  // Index i and weight u with t between run.t[i] and run.t[i + 1].
+  function locate(run, t) {
+    const ts = run.t;
+    if (t <= ts[0]) return [0, 0];
+    if (t >= ts[ts.length - 1]) return [ts.length - 1, 0];
+    let lo = 0, hi = ts.length - 1;
+    while (hi - lo > 1) {
+      const mid = (lo + hi) >> 1;
+      if (ts[mid] <= t) lo = mid; else hi = mid;
+    }
+    return [lo, (t - ts[lo]) / (ts[lo + 1] - ts[lo])];
+  }
+  const lerp = (arr, i, u) => (u > 0 && i + 1 < arr.length ? arr[i] + u * (arr[i + 1] - arr[i]) : arr[i]);
+
+  // ---------------------------------------------------------------- page
+  const body = document.body;
+  const header = el('header', {}, body);
+  el('h1', {}, header, RUNS.map((r) => r.title).join('  ·  '));
+  const info = RUNS.map((r) => {
+    const s = r.summary || {};
+    const first = (s.strikes || [])[0];
+    const v = first ? first.hammer_velocity_m_s.toFixed(2) + ' m/s at ' + fmtMs(first.time_s) : 'no strike';
+    return r.name + ': ' + v;
+  }).join('   ');
+  el('p', {}, header, info);
+
+  const controls = el('div', { id: 'controls' }, body);
+  const btn = (id, label, title) => el('button', { id, title, type: 'button' }, controls, label);
+  const bPrevEvent = btn('prev-event', '« event', 'previous event (Shift+←)');
+  const bStepBack = btn('step-back', '‹ frame', 'one frame back (←)');
+  const bPlay = btn('play', '▶ play', 'play / pause (Space)');
+  const bStepFwd = btn('step-forward', 'frame ›', 'one frame on (→)');
+  const bNextEvent = btn('next-event', 'event »', 'next event (Shift+→)');
+  const timeLabel = el('span', { id: 'time' }, controls, '');
+  const speedLabel = el('label', {}, controls, 'speed');
+  const speedSel = el('select', { id: 'speed', title: 'slow motion (+ / −)' }, speedLabel);
+  SPEEDS.forEach(([name, v]) => {
+    const o = el('option', { value: String(v) }, speedSel, name);
+    if (v === state.speed) o.selected = true;
+  });
+  const loopLabel = el('label', {}, controls, 'loop');
+  const loopBox = el('input', { id: 'loop', type: 'checkbox', title: 'loop (L)' }, loopLabel);
+  const zoomLabel = el('label', {}, controls, 'zoom');
+  const zoomSel = el('select', { id: 'zoom', title: 'zoom presets (Z cycles)' }, zoomLabel);
+  const zoomNames = ['whole action'];
+  for (const run of RUNS) for (const k of Object.keys(run.zoom || {})) if (!zoomNames.includes(k)) zoomNames.push(k);
+  zoomNames.forEach((z) => el('option', { value: z }, zoomSel, z));
+  const gainLabel = el('label', {}, controls, 'arrows');
+  const gainInput = el('input', { id: 'arrow-gain', type: 'range', min: '0.25', max: '4', step: '0.25', value: '1', title: 'force arrow length' }, gainLabel);
+  el('span', { class: 'legend' }, controls,
+    'keys: Space play, ←/→ frame, Shift+←/→ event, +/− speed, L loop, Z zoom, Home/End');
+
+  const timeline = el('div', { id: 'timeline' }, body);
+  const scrubber = el('input', {
+    id: 'scrubber', type: 'range', min: String(tStart), max: String(tEnd), step: 'any', value: String(tStart),
+  }, timeline);
+  const marks = el('div', { id: 'event-marks' }, timeline);
+  const eventList = el('div', { id: 'event-list' }, timeline);
+  // Events of all runs, in time order, each tagged with its run.
+  const events = [];
+  RUNS.forEach((run, k) => (run.events || []).forEach((e) => events.push({ name: e.name, t: e.time_s, run: k })));
+  events.sort((a, b) => a.t - b.t);
+  const eventButtons = events.map((e) => {
+    const pos = (100 * (e.t - tStart)) / (tEnd - tStart || 1);
+    const m = el('span', { title: e.name + ' at ' + fmtMs(e.t) + (RUNS.length > 1 ? ' (' + RUNS[e.run].name + ')' : '') }, marks);
+    m.style.left = 'calc(' + pos + '% - 1px)';
+    m.style.background = RUN_COLORS[e.run % RUN_COLORS.length];
+    m.addEventListener('click', () => seek(e.t, true));
+    const b = el('button', { type: 'button', 'data-time': String(e.t) }, eventList,
+      e.name.replace(/_/g, ' ') + ' ' + fmtMs(e.t) + (RUNS.length > 1 ? ' [' + (e.run + 1) + ']' : ''));
+    b.addEventListener('click', () => seek(e.t, true));
+    return b;
+  });
+
+  const main = el('main', {}, body);
+
+  // ---------------------------------------------------------------- 2D views
+  function sceneBounds(scene) {
+    const b = { x0: Infinity, x1: -Infinity, y0: Infinity, y1: -Infinity };
+    const add = (p, pad) => {
+      b.x0 = Math.min(b.x0, p[0] - pad); b.x1 = Math.max(b.x1, p[0] + pad);
+      b.y0 = Math.min(b.y0, p[1] - pad); b.y1 = Math.max(b.y1, p[1] + pad);
+    };
+    for (const part of scene.parts) {
+      for (const pc of part.pieces) {
+        if (pc.kind === 'circle') add(pc.c, pc.r); else pc.pts.forEach((p) => add(p, 0));
+      }
+    }
+    return b;
+  }
+
+  function carryAt(run, frame, i, u) {
+    const c = run.carry[frame];
+    if (!c) return [0, 0, 0];
+    return [lerp(c.a, i, u), lerp(c.x, i, u), lerp(c.y, i, u)];
+  }
+
+  const views = RUNS.map((run, k) => {
+    const box = el('section', { class: 'view', id: 'view-' + k }, main);
+    el('h2', {}, box, (RUNS.length > 1 ? '[' + (k + 1) + '] ' : '') + run.title + ' — 2D, to scale');
+    const canvas = el('canvas', { id: 'canvas2d-' + k, 'aria-label': '2D view of ' + run.title }, box);
+    el('div', { class: 'note' }, box,
+      'Drag to pan, wheel to zoom. Red arrows: contact forces on the moving part (log scale, see legend).');
+    const view = { run, canvas, box, bounds: sceneBounds(run.scene), center: null, halfWidth: null };
+    fitZoom(view, 'whole action');
+    let drag = null;
+    canvas.addEventListener('mousedown', (ev) => { drag = [ev.clientX, ev.clientY]; canvas.style.cursor = 'grabbing'; });
+    window.addEventListener('mouseup', () => { drag = null; canvas.style.cursor = 'grab'; });
+    window.addEventListener('mousemove', (ev) => {
+      if (!drag) return;
+      const s = scaleOf(view);
+      view.center = [view.center[0] - (ev.clientX - drag[0]) / s, view.center[1] + (ev.clientY - drag[1]) / s];
+      drag = [ev.clientX, ev.clientY];
+      draw();
+    });
+    canvas.addEventListener('wheel', (ev) => {
+      ev.preventDefault();
+      view.halfWidth = clamp(view.halfWidth * Math.exp(ev.deltaY * 0.001), 2, 2000);
+      draw();
+    }, { passive: false });
+    return view;
+  });
+
+  function fitZoom(view, name) {
+    const z = (view.run.zoom || {})[name];
+    if (z) {
+      view.center = z.center.slice();
+      view.halfWidth = z.half_width;
+    } else {
+      const b = view.bounds;
+      const aspect = (view.canvas.clientWidth || 600) / (view.canvas.clientHeight || 360);
+      view.center = [(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2];
+      view.halfWidth = 1.04 * Math.max((b.x1 - b.x0) / 2, ((b.y1 - b.y0) / 2) * aspect);
+    }
+  }
+
+  function scaleOf(view) {
+    const w = view.canvas.clientWidth || 600;
+    return w / (2 * view.halfWidth);
+  }
+
+  function sizeCanvas(canvas) {
+    const dpr = window.devicePixelRatio || 1;
+    const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+    const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+    if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+    return dpr;
+  }
+
+  function drawView(view) {
+    const { run, canvas } = view;
+    const dpr = sizeCanvas(canvas);
+    const ctx = canvas.getContext('2d');
+    const W = canvas.width, H = canvas.height;
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.fillStyle = '#ffffff';
+    ctx.fillRect(0, 0, W, H);
+    const s = scaleOf(view) * dpr; // device px per mm
+    const toScreen = (p) => [W / 2 + (p[0] - view.center[0]) * s, H / 2 - (p[1] - view.center[1]) * s];
+    const [i, u] = locate(run, state.t);
+    ctx.setTransform(s, 0, 0, -s, W / 2 - view.center[0] * s, H / 2 + view.center[1] * s);
+    const px = 1 / s; // one device pixel in mm
+    const withFrame = (frame, fn) => {
+      ctx.save();
+      if (frame) {
+        const [a, x, y] = carryAt(run, frame, i, u);
+        ctx.translate(x, y);
+        ctx.rotate(a);
+      }
+      fn();
+      ctx.restore();
+    };
+    // Parts.
+    for (const part of run.scene.parts) {
+      withFrame(part.frame, () => {
+        for (const pc of part.pieces) {
+          ctx.beginPath();
+          if (pc.kind === 'circle') {
+            ctx.arc(pc.c[0], pc.c[1], pc.r, 0, 2 * Math.PI);
+            ctx.fillStyle = pc.fill; ctx.fill();
+            ctx.lineWidth = px; ctx.strokeStyle = '#333'; ctx.stroke();
+          } else if (pc.kind === 'polygon') {
+            pc.pts.forEach((p, k) => (k ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
+            ctx.closePath();
+            ctx.fillStyle = pc.fill; ctx.fill();
+            ctx.lineWidth = px; ctx.strokeStyle = '#333'; ctx.stroke();
+          } else if (pc.kind === 'wire') {
+            pc.pts.forEach((p, k) => (k ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
+            ctx.lineWidth = pc.width; ctx.strokeStyle = pc.fill; ctx.stroke();
+          }
+        }
+        for (const p of part.pivots) {
+          ctx.beginPath(); ctx.arc(p[0], p[1], 0.9, 0, 2 * Math.PI);
+          ctx.fillStyle = '#fff'; ctx.fill(); ctx.lineWidth = px; ctx.strokeStyle = '#000'; ctx.stroke();
+        }
+      });
+    }
+    // Contact shapes (thin), as the simulation uses them.
+    ctx.strokeStyle = '#1f4e9c';
+    for (const c of run.scene.contacts) {
+      for (const side of c.sides) {
+        withFrame(side.frame, () => {
+          ctx.lineWidth = px;
+          for (const sh of side.shapes) {
+            ctx.beginPath();
+            if (sh.kind === 'circle') ctx.arc(sh.c[0], sh.c[1], sh.r, 0, 2 * Math.PI);
+            else if (sh.kind === 'segment') { ctx.moveTo(sh.pts[0][0], sh.pts[0][1]); ctx.lineTo(sh.pts[1][0], sh.pts[1][1]); }
+            else if (sh.kind === 'arc') ctx.arc(sh.c[0], sh.c[1], sh.r, sh.start, sh.start + sh.sweep);
+            ctx.stroke();
+          }
+        });
+      }
+    }
+    // Force arrows on the pressed contacts.
+    const active = [];
+    for (const [name, c] of Object.entries(run.contacts)) {
+      const k = u > 0.5 && i + 1 < c.f.length ? i + 1 : i;
+      const f = lerp(c.f, i, u);
+      if (!(c.f[k] > 0) || !(f > 0)) continue;
+      const p = [c.px[k], c.py[k]], n = [c.nx[k], c.ny[k]];
+      const L = arrowMm(f, state.gain);
+      const tip = [p[0] + n[0] * L, p[1] + n[1] * L];
+      const color = CONTACT_COLORS[name] || '#c0392b';
+      ctx.lineWidth = 2.2 * px * dpr; ctx.strokeStyle = color; ctx.fillStyle = color;
+      ctx.beginPath(); ctx.moveTo(p[0], p[1]); ctx.lineTo(tip[0], tip[1]); ctx.stroke();
+      const h = Math.min(2.5, 0.35 * L + 0.6), w = 0.5 * h;
+      ctx.beginPath();
+      ctx.moveTo(tip[0] + n[0] * h * 0.6, tip[1] + n[1] * h * 0.6);
+      ctx.lineTo(tip[0] - n[1] * w, tip[1] + n[0] * w);
+      ctx.lineTo(tip[0] + n[1] * w, tip[1] - n[0] * w);
+      ctx.closePath(); ctx.fill();
+      ctx.beginPath(); ctx.arc(p[0], p[1], 0.8, 0, 2 * Math.PI); ctx.fill();
+      active.push([name, f, tip, color]);
+    }
+    // Text in screen space.
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
+    ctx.textBaseline = 'middle';
+    if (view.halfWidth < 120) {
+      ctx.fillStyle = '#333';
+      for (const part of run.scene.parts) {
+        const [a, x, y] = part.frame ? carryAt(run, part.frame, i, u) : [0, 0, 0];
+        for (const l of part.labels) {
+          const q = [x + Math.cos(a) * l.anchor[0] - Math.sin(a) * l.anchor[1], y + Math.sin(a) * l.anchor[0] + Math.cos(a) * l.anchor[1]];
+          const sp = toScreen([q[0] + l.offset[0], q[1] + l.offset[1]]);
+          ctx.textAlign = l.align === 'middle' ? 'center' : l.align === 'end' ? 'right' : 'left';
+          ctx.fillText(l.text, sp[0], sp[1]);
+        }
+      }
+    }
+    ctx.textAlign = 'left';
+    for (const [name, f, tip, color] of active) {
+      const sp = toScreen(tip);
+      ctx.fillStyle = color;
+      ctx.fillText(name.replace(/_/g, ' ') + ' ' + f.toFixed(f < 10 ? 2 : 1) + ' N', sp[0] + 4 * dpr, sp[1]);
+    }
+    // Time, scale bar, arrow legend.
+    ctx.fillStyle = '#111';
+    ctx.font = (13 * dpr) + 'px system-ui, sans-serif';
+    ctx.fillText('t = ' + fmtMs(state.t), 10 * dpr, 14 * dpr);
+    ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
+    const bar = [1, 2, 5, 10, 20, 50, 100].find((mm) => mm * s > 60 * dpr) || 100;
+    const bx = W - 16 * dpr - bar * s, by = H - 14 * dpr;
+    ctx.strokeStyle = '#000'; ctx.lineWidth = 1.5 * dpr;
+    ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + bar * s, by);
+    ctx.moveTo(bx, by - 4 * dpr); ctx.lineTo(bx, by + 4 * dpr);
+    ctx.moveTo(bx + bar * s, by - 4 * dpr); ctx.lineTo(bx + bar * s, by + 4 * dpr); ctx.stroke();
+    ctx.textAlign = 'center'; ctx.fillText(bar + ' mm', bx + (bar * s) / 2, by - 9 * dpr);
+    ctx.textAlign = 'left';
+    let lx = 10 * dpr;
+    const ly = H - 14 * dpr;
+    ctx.fillStyle = '#c0392b'; ctx.strokeStyle = '#c0392b';
+    for (const f of [1, 10, 100]) {
+      const len = arrowMm(f, state.gain) * s;
+      ctx.beginPath(); ctx.moveTo(lx, ly); ctx.lineTo(lx + len, ly); ctx.stroke();
+      ctx.fillText(f + ' N', lx + len + 3 * dpr, ly);
+      lx += len + 40 * dpr;
+    }
+    view.canvas.dataset.activeContacts = active.map((a) => a[0]).join(' ');
+  }
+
+  // ---------------------------------------------------------------- plots
+  const plotsBox = el('section', { id: 'plots' }, main);
+  const plotDefs = [];
+  const seriesOf = (run, id) => (run.series.find((s) => s.id === id) || {}).values;
+  plotDefs.push({ id: 'hammer-angle', title: 'Hammer angle (°)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'hammer_angle_deg'), color: RUN_COLORS[k % 6] })) });
+  plotDefs.push({ id: 'hammer-speed', title: 'Hammer speed at the strike point (m/s)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'hammer_speed_m_s'), color: RUN_COLORS[k % 6] })) });
+  plotDefs.push({ id: 'key-depth', title: 'Key-front depth below rest (mm)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'key_depth_mm'), color: RUN_COLORS[k % 6] })) });
+  const forceLines = [];
+  RUNS.forEach((r, k) => {
+    for (const [name, c] of Object.entries(r.contacts)) {
+      if (!c.f.some((f) => f > 0)) continue;
+      forceLines.push({ run: k, label: name.replace(/_/g, ' ') + (RUNS.length > 1 ? ' [' + (k + 1) + ']' : ''), values: c.f, color: CONTACT_COLORS[name] || '#333', dash: k ? [5, 3] : [] });
+    }
+  });
+  plotDefs.push({ id: 'contact-forces', title: 'Contact forces (N)', lines: forceLines });
+  plotDefs.push({ id: 'energy', title: 'Energy (mJ): kinetic (solid), gravity from rest (dashed)', lines: RUNS.flatMap((r, k) => [
+    { run: k, label: 'kinetic ' + r.name, values: seriesOf(r, 'kinetic_mj'), color: RUN_COLORS[k % 6] },
+    { run: k, label: 'gravity ' + r.name, values: seriesOf(r, 'gravity_mj'), color: RUN_COLORS[k % 6], dash: [5, 3] },
+  ]) });
+  if (RUNS.some((r) => seriesOf(r, 'key_drive_force_n'))) {
+    plotDefs.push({ id: 'hand-force', title: 'Hand force at the key front (N)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'key_drive_force_n'), color: RUN_COLORS[k % 6] })).filter((l) => l.values) });
+  }
+  const plots = plotDefs.map((def) => {
+    const box = el('div', { class: 'plot', id: 'plot-' + def.id }, plotsBox);
+    el('h3', {}, box, def.title);
+    const canvas = el('canvas', { id: 'plotcanvas-' + def.id }, box);
+    const legend = el('div', { class: 'legend' }, box);
+    def.lines.forEach((l) => {
+      const s = el('span', {}, legend);
+      const sw = el('i', {}, s); sw.style.background = l.color;
+      s.appendChild(document.createTextNode(l.label));
+    });
+    let lo = Infinity, hi = -Infinity;
+    for (const l of def.lines) for (const v of l.values || []) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    if (!isFinite(lo)) { lo = 0; hi = 1; }
+    if (hi - lo < 1e-9) { hi += 1; lo -= 1; }
+    const pad = 0.06 * (hi - lo);
+    const plot = { def, canvas, lo: lo - pad, hi: hi + pad, margin: 44 };
+    canvas.addEventListener('click', (ev) => {
+      const rect = canvas.getBoundingClientRect();
+      const x = ev.clientX - rect.left;
+      const w = rect.width - plot.margin - 22;
+      seek(tStart + clamp((x - plot.margin) / w, 0, 1) * (tEnd - tStart), true);
+    });
+    return plot;
+  });
+
+  function niceTicks(lo, hi, n) {
+    const span = hi - lo, raw = span / n;
+    const mag = Math.pow(10, Math.floor(Math.log10(raw)));
+    const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => s >= raw) || mag * 10;
+    const out = [];
+    for (let v = Math.ceil(lo / step) * step; v <= hi + 1e-12; v += step) out.push(v);
+    return out;
+  }
+
+  function drawPlot(plot) {
+    const { canvas, def } = plot;
+    const dpr = sizeCanvas(canvas);
+    const ctx = canvas.getContext('2d');
+    const W = canvas.width, H = canvas.height;
+    const m = plot.margin * dpr, top = 6 * dpr, bottom = 18 * dpr, right = 22 * dpr;
+    const X = (t) => m + ((t - tStart) / (tEnd - tStart || 1)) * (W - m - right);
+    const Y = (v) => top + (1 - (v - plot.lo) / (plot.hi - plot.lo)) * (H - top - bottom);
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.fillStyle = '#fff'; ctx.fillRect(0, 0, W, H);
+    ctx.font = (10 * dpr) + 'px system-ui, sans-serif';
+    ctx.strokeStyle = '#eee'; ctx.fillStyle = '#666'; ctx.lineWidth = dpr;
+    ctx.textAlign = 'right'; ctx.textBaseline = 'middle';
+    for (const v of niceTicks(plot.lo, plot.hi, 4)) {
+      ctx.beginPath(); ctx.moveTo(m, Y(v)); ctx.lineTo(W - right, Y(v)); ctx.stroke();
+      ctx.fillText(Math.abs(v) < 1e-12 ? '0' : +v.toPrecision(4) + '', m - 4 * dpr, Y(v));
+    }
+    ctx.textAlign = 'center'; ctx.textBaseline = 'top';
+    for (const v of niceTicks(tStart * 1e3, tEnd * 1e3, 6)) {
+      ctx.beginPath(); ctx.moveTo(X(v / 1e3), top); ctx.lineTo(X(v / 1e3), H - bottom); ctx.stroke();
+      ctx.fillText(+v.toPrecision(4) + ' ms', X(v / 1e3), H - bottom + 3 * dpr);
+    }
+    ctx.strokeStyle = 'rgba(192,57,43,0.25)';
+    for (const e of events) { ctx.beginPath(); ctx.moveTo(X(e.t), top); ctx.lineTo(X(e.t), H - bottom); ctx.stroke(); }
+    for (const l of def.lines) {
+      if (!l.values) continue;
+      const ts = RUNS[l.run].t;
+      ctx.strokeStyle = l.color; ctx.lineWidth = 1.4 * dpr; ctx.setLineDash((l.dash || []).map((d) => d * dpr));
+      ctx.beginPath();
+      l.values.forEach((v, k) => (k ? ctx.lineTo(X(ts[k]), Y(v)) : ctx.moveTo(X(ts[k]), Y(v))));
+      ctx.stroke();
+      ctx.setLineDash([]);
+    }
+    ctx.strokeStyle = '#000'; ctx.lineWidth = 1.2 * dpr;
+    ctx.beginPath(); ctx.moveTo(X(state.t), top); ctx.lineTo(X(state.t), H - bottom); ctx.stroke();
+  }
+
+  el('footer', {}, body,
+    'Generated by piano report ' + DATA.version + '. Times from the start of the run; the action is drawn to scale from the run\'s parameters. ' +
+    'Link to a moment with #t=SECONDS.');
+
+  // ---------------------------------------------------------------- clock
+  function draw() {
+    views.forEach(drawView);
+    plots.forEach(drawPlot);
+    timeLabel.textContent = 't = ' + fmtMs(state.t) + ' / ' + fmtMs(tEnd);
+    scrubber.value = String(state.t);
+    eventButtons.forEach((b, k) => b.classList.toggle('past', events[k].t <= state.t + 1e-12));
+    bPlay.textContent = state.playing ? '❚❚ pause' : '▶ play';
+    body.dataset.time = String(state.t);
+    body.dataset.playing = String(state.playing);
+  }
+
+  function seek(t, updateHash) {
+    state.t = clamp(t, tStart, tEnd);
+    if (updateHash) {
+      try { history.replaceState(null, '', '#t=' + state.t.toFixed(6)); } catch (e) { /* file:// may refuse */ }
+    }
+    draw();
+  }
+
+  function play(on) {
+    state.playing = on;
+    state.last = null;
+    if (on && state.t >= tEnd) state.t = tStart;
+    if (!on) seek(state.t, true); else draw();
+    if (on) requestAnimationFrame(tick);
+  }
+
+  function tick(now) {
+    if (!state.playing) return;
+    if (state.last !== null) {
+      let t = state.t + ((now - state.last) / 1000) * state.speed;
+      if (t > tEnd) {
+        if (state.loop) t = tStart + ((t - tStart) % (tEnd - tStart || 1));
+        else { state.t = tEnd; play(false); return; }
+      }
+      state.t = t;
+      draw();
+    }
+    state.last = now;
+    requestAnimationFrame(tick);
+  }
+
+  const step = (k) => { play(false); seek(state.t + k * frameDt, true); };
+  function jumpEvent(dir) {
+    play(false);
+    const eps = 1e-9;
+    const e = dir > 0 ? events.find((x) => x.t > state.t + eps) : [...events].reverse().find((x) => x.t < state.t - eps);
+    if (e) seek(e.t, true);
+  }
+  function setSpeed(delta) {
+    const k = clamp(SPEEDS.findIndex(([, v]) => v === state.speed) + delta, 0, SPEEDS.length - 1);
+    state.speed = SPEEDS[k][1];
+    speedSel.value = String(state.speed);
+  }
+
+  bPlay.addEventListener('click', () => play(!state.playing));
+  bStepBack.addEventListener('click', () => step(-1));
+  bStepFwd.addEventListener('click', () => step(1));
+  bPrevEvent.addEventListener('click', () => jumpEvent(-1));
+  bNextEvent.addEventListener('click', () => jumpEvent(1));
+  speedSel.addEventListener('change', () => { state.speed = parseFloat(speedSel.value); });
+  loopBox.addEventListener('change', () => { state.loop = loopBox.checked; });
+  zoomSel.addEventListener('change', () => { views.forEach((v) => fitZoom(v, zoomSel.value)); draw(); });
+  gainInput.addEventListener('input', () => { state.gain = parseFloat(gainInput.value); draw(); });
+  scrubber.addEventListener('input', () => { play(false); seek(parseFloat(scrubber.value), true); });
+  window.addEventListener('resize', () => { views.forEach((v) => fitZoom(v, zoomSel.value)); draw(); });
+  window.addEventListener('keydown', (ev) => {
+    if (ev.target && ev.target.tagName === 'SELECT') return;
+    switch (ev.key) {
+      case ' ': ev.preventDefault(); play(!state.playing); break;
+      case 'ArrowRight': ev.preventDefault(); ev.shiftKey ? jumpEvent(1) : step(1); break;
+      case 'ArrowLeft': ev.preventDefault(); ev.shiftKey ? jumpEvent(-1) : step(-1); break;
+      case '+': case '=': setSpeed(1); break;
+      case '-': case '_': setSpeed(-1); break;
+      case 'l': case 'L': state.loop = !state.loop; loopBox.checked = state.loop; break;
+      case 'z': case 'Z': {
+        zoomSel.selectedIndex = (zoomSel.selectedIndex + 1) % zoomSel.options.length;
+        views.forEach((v) => fitZoom(v, zoomSel.value)); draw(); break;
+      }
+      case 'Home': seek(tStart, true); break;
+      case 'End': seek(tEnd, true); break;
+      default: return;
+    }
+  });
+
+  function fromHash() {
+    const m = /(?:^#|&)t=([-+0-9.eE]+)/.exec(location.hash);
+    if (m && isFinite(parseFloat(m[1]))) { play(false); seek(parseFloat(m[1]), false); }
+  }
+  window.addEventListener('hashchange', fromHash);
+
+  // For tests and for scripting from the console.
+  window.pianoReport = {
+    seek: (t) => seek(t, true), play: () => play(true), pause: () => play(false),
+    time: () => state.t, playing: () => state.playing, setSpeed: (v) => { state.speed = v; speedSel.value = String(v); },
+    events: () => events.slice(), runs: () => RUNS.map((r) => r.name),
+    hammerAngle: (k) => { const r = RUNS[k || 0]; const [i, u] = locate(r, state.t); return lerp(seriesOf(r, 'hammer_angle_deg'), i, u); },
+    activeContacts: (k) => views[k || 0].canvas.dataset.activeContacts.split(' ').filter(Boolean),
+  };
+
+  draw();
+  fromHash();
+})();

@@ -1,0 +1,156 @@
+//! The interactive report: one self-contained page whose embedded data match the run.
+
+use std::path::{Path, PathBuf};
+
+use piano_action::report::{report_html, write_report};
+use piano_action::scenario::{Scenario, write_run_dir};
+use piano_action::{ActionParams, PianoError};
+
+fn run_dir(name: &str, scenario: &str) -> PathBuf {
+    let dir = std::env::temp_dir()
+        .join(format!("piano-report-{}", std::process::id()))
+        .join(name);
+    let scenario = Scenario::from_toml_str(scenario).unwrap();
+    let params = ActionParams::reference();
+    let run = scenario.run(&params).unwrap();
+    write_run_dir(&dir, &scenario, &params, &run).unwrap();
+    dir
+}
+
+const STRUCK: &str = "model = \"double\"\nduration_s = 0.3\n[input]\nkind = \"touch\"\nstyle = \"struck\"\nfinger_speed_m_s = 0.8\n";
+
+/// The JSON embedded in the page.
+fn embedded(html: &str) -> serde_json::Value {
+    let start = r#"<script type="application/json" id="report-data">"#;
+    let a = html.find(start).unwrap() + start.len();
+    let b = a + html[a..].find("</script>").unwrap();
+    serde_json::from_str(&html[a..b].replace("<\\/", "</")).unwrap()
+}
+
+fn csv(dir: &Path, name: &str) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join(name)).unwrap();
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn the_report_embeds_the_run_and_nothing_from_the_network() {
+    let dir = run_dir("struck", STRUCK);
+    let html = report_html(std::slice::from_ref(&dir)).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    // Self-contained: no address of any kind, so no request can leave the page.
+    for pattern in ["http://", "https://", "src=", "href=", "@import", "url("] {
+        assert!(!html.contains(pattern), "the page contains {pattern}");
+    }
+    // A 0.3 s run at 1 ms stays well under 2 MB.
+    assert!(html.len() < 2_000_000, "{} bytes", html.len());
+    eprintln!("report of a 0.3 s run: {} kB", html.len() / 1000);
+
+    let data = embedded(&html);
+    let run = &data["runs"][0];
+    let (header, rows) = csv(&dir, "trajectory.csv");
+    let t = run["t"].as_array().unwrap();
+    assert_eq!(t.len(), rows.len(), "one frame per trajectory row");
+    // The hammer turns about its flange: its carried angle is its coordinate, and the
+    // plotted angle is the same in degrees.
+    let hq = header.iter().position(|h| h == "hammer_q").unwrap();
+    let angle = run["carry"]["hammer"]["a"].as_array().unwrap();
+    let plotted = run["series"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["id"] == "hammer_angle_deg")
+        .unwrap()["values"]
+        .as_array()
+        .unwrap();
+    for (i, row) in rows.iter().enumerate() {
+        assert!(
+            (angle[i].as_f64().unwrap() - row[hq]).abs() < 2e-6,
+            "frame {i}"
+        );
+        assert!((plotted[i].as_f64().unwrap() - row[hq].to_degrees()).abs() < 1e-3);
+    }
+    // Events and summary are the run's own.
+    let events: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("events.json")).unwrap()).unwrap();
+    assert_eq!(run["events"], events);
+    // The string force is on in the frames during the blow and off at rest, and agrees
+    // with contacts.csv.
+    let (ch, crow) = csv(&dir, "contacts.csv");
+    let col = ch
+        .iter()
+        .position(|h| h == "hammer_string_force_n")
+        .unwrap();
+    let f = run["contacts"]["hammer_string"]["f"].as_array().unwrap();
+    let peak = (0..f.len())
+        .max_by(|&a, &b| f[a].as_f64().unwrap().total_cmp(&f[b].as_f64().unwrap()))
+        .unwrap();
+    assert!(f[peak].as_f64().unwrap() > 5.0, "string force {}", f[peak]);
+    assert!((f[peak].as_f64().unwrap() - crow[peak][col]).abs() < 1e-2);
+    assert_eq!(f[0].as_f64().unwrap(), 0.0);
+    // The force acts on the hammer, pushing it down, at the string's height.
+    let ny = run["contacts"]["hammer_string"]["ny"][peak]
+        .as_f64()
+        .unwrap();
+    let py = run["contacts"]["hammer_string"]["py"][peak]
+        .as_f64()
+        .unwrap();
+    assert!(ny < -0.99, "normal {ny}");
+    let string_y = ActionParams::reference().regulation.string_y_mm;
+    assert!((py - string_y).abs() < 1.0, "contact at y = {py} mm");
+    // Zoom presets for the places where millimetres matter.
+    for z in ["let-off", "jack and knuckle", "string", "backcheck"] {
+        assert!(run["zoom"][z]["center"].is_array(), "zoom {z}");
+    }
+}
+
+#[test]
+fn several_runs_share_one_page_and_files_are_kept_safe() {
+    let a = run_dir("struck-a", STRUCK);
+    let b = run_dir(
+        "single",
+        "model = \"single\"\nduration_s = 0.1\n[input]\nkind = \"force\"\nforce_n = 10.0\n",
+    );
+    let out = a.parent().unwrap().join("both.html");
+    write_report(&[a.clone(), b.clone()], &out).unwrap();
+    let html = std::fs::read_to_string(&out).unwrap();
+    let data = embedded(&html);
+    assert_eq!(data["runs"].as_array().unwrap().len(), 2);
+    assert_eq!(data["runs"][1]["model"], "single");
+    assert!(data["runs"][1]["carry"].get("repetition_lever").is_none());
+    // A report is replaced; any other file is not.
+    write_report(std::slice::from_ref(&a), &out).unwrap();
+    let mine = a.parent().unwrap().join("notes.html");
+    std::fs::write(&mine, "my notes").unwrap();
+    let e = write_report(std::slice::from_ref(&a), &mine).unwrap_err();
+    assert!(e.to_string().contains("not a piano report"), "{e}");
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my notes");
+}
+
+#[test]
+fn broken_run_directories_are_named() {
+    let dir = run_dir("broken", STRUCK);
+    let csv = dir.join("trajectory.csv");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[3] = "0.002,oops";
+    std::fs::write(&csv, lines.join("\n")).unwrap();
+    let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
+    assert!(e.to_string().contains("trajectory.csv line 4"), "{e}");
+    let missing = dir.join("nothing-here");
+    let e = report_html(&[missing]).unwrap_err();
+    assert!(e.to_string().contains("run.json"), "{e}");
+    assert!(matches!(
+        report_html(&[]),
+        Err(PianoError::Params { field, .. }) if field == "RUN_DIR"
+    ));
+}
