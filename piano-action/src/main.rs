@@ -427,7 +427,46 @@ fn demo(params: &ActionParams) -> Result<(), String> {
     }
     println!("\n`vs HS`: key bottom minus string contact (ms). `piano --help` for more;");
     println!("`piano params` writes the parameter file, `--params FILE` loads your own.");
-    Ok(())
+    demo_report(params)
+}
+
+/// Writes a pressed and a struck touch of about the same loudness as run directories in
+/// the temporary folder, and their report side by side.
+fn demo_report(params: &ActionParams) -> Result<(), String> {
+    use piano_action::scenario::{InputSpec, Scenario, TouchStyleName, write_run_dir};
+    let root = std::env::temp_dir().join("piano-demo");
+    let touch = |style, peak_force_n, finger_speed_m_s| InputSpec::Touch {
+        style,
+        peak_force_n,
+        finger_speed_m_s,
+        finger_mass_g: None,
+        rise_s: None,
+        arm_damping_n_s_m: None,
+    };
+    let mut dirs = Vec::new();
+    for (name, input) in [
+        (
+            "pressed-10N",
+            touch(TouchStyleName::Pressed, Some(10.0), None),
+        ),
+        (
+            "struck-0.8m_s",
+            touch(TouchStyleName::Struck, None, Some(0.8)),
+        ),
+    ] {
+        let scenario = Scenario {
+            model: "double".into(),
+            duration_s: 0.1,
+            output_step_s: 5e-4,
+            input,
+        };
+        let run = scenario.run(params).map_err(|e| e.to_string())?;
+        let dir = root.join(name);
+        write_run_dir(&dir, &scenario, params, &run).map_err(|e| e.to_string())?;
+        dirs.push(dir);
+    }
+    println!("\nA pressed and a struck touch of about the same loudness, in slow motion:");
+    write_report(&dirs, &root.join("report.html"))
 }
 
 fn main() -> ExitCode {

@@ -244,7 +244,13 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         ("capstan", "capstan_heel", 18.0),
     ] {
         if action.contacts.contains_key(contact) {
-            let p = action.contact_output(contact, 0.0, &x0)?.point;
+            // The first side's surface point (the string, the button, the jack top, the
+            // backcheck face, the capstan), not the middle of a wide gap.
+            let o = action.contact_output(contact, 0.0, &x0)?;
+            let p = [
+                o.point[0] - 0.5 * o.gap * o.normal[0],
+                o.point[1] - 0.5 * o.gap * o.normal[1],
+            ];
             zoom.insert(
                 label.into(),
                 json!({"center": [r(p[0] * 1e3, 2), r(p[1] * 1e3, 2)], "half_width": half}),

@@ -16,9 +16,9 @@
     ['1/1000', 0.001], ['1/300', 1 / 300], ['1/100', 0.01], ['1/30', 1 / 30],
     ['1/10', 0.1], ['1/3', 1 / 3], ['real time', 1],
   ];
-  // Arrow length (mm) for a force f (N): logarithmic, so 0.1 N and 100 N both read.
-  const ARROW_MM_PER_DECADE = 6;
-  const arrowMm = (f, gain) => gain * ARROW_MM_PER_DECADE * Math.log10(1 + f / 0.1);
+  // Arrow length (screen px) for a force f (N): logarithmic, so 0.1 N and 100 N both read.
+  const ARROW_PX_PER_DECADE = 22;
+  const arrowPx = (f, gain) => gain * ARROW_PX_PER_DECADE * Math.log10(1 + f / 0.1);
 
   const tStart = Math.min(...RUNS.map((r) => r.t[0]));
   const tEnd = Math.max(...RUNS.map((r) => r.t[r.t.length - 1]));
@@ -252,26 +252,13 @@
         });
       }
     }
-    // Force arrows on the pressed contacts.
+    // Pressed contacts: which, how hard, where (arrows drawn below, in screen space).
     const active = [];
     for (const [name, c] of Object.entries(run.contacts)) {
       const k = u > 0.5 && i + 1 < c.f.length ? i + 1 : i;
       const f = lerp(c.f, i, u);
       if (!(c.f[k] > 0) || !(f > 0)) continue;
-      const p = [c.px[k], c.py[k]], n = [c.nx[k], c.ny[k]];
-      const L = arrowMm(f, state.gain);
-      const tip = [p[0] + n[0] * L, p[1] + n[1] * L];
-      const color = CONTACT_COLORS[name] || '#c0392b';
-      ctx.lineWidth = 2.2 * px * dpr; ctx.strokeStyle = color; ctx.fillStyle = color;
-      ctx.beginPath(); ctx.moveTo(p[0], p[1]); ctx.lineTo(tip[0], tip[1]); ctx.stroke();
-      const h = Math.min(2.5, 0.35 * L + 0.6), w = 0.5 * h;
-      ctx.beginPath();
-      ctx.moveTo(tip[0] + n[0] * h * 0.6, tip[1] + n[1] * h * 0.6);
-      ctx.lineTo(tip[0] - n[1] * w, tip[1] + n[0] * w);
-      ctx.lineTo(tip[0] + n[1] * w, tip[1] - n[0] * w);
-      ctx.closePath(); ctx.fill();
-      ctx.beginPath(); ctx.arc(p[0], p[1], 0.8, 0, 2 * Math.PI); ctx.fill();
-      active.push([name, f, tip, color]);
+      active.push({ name, f, p: [c.px[k], c.py[k]], n: [c.nx[k], c.ny[k]], color: CONTACT_COLORS[name] || '#c0392b' });
     }
     // Text in screen space.
     ctx.setTransform(1, 0, 0, 1, 0, 0);
@@ -289,11 +276,26 @@
         }
       }
     }
+    // Force arrows on the moving part, log scaled in screen pixels so they read at any
+    // zoom: 0.1 N, 1 N, 10 N and 100 N are equal steps (see the legend).
     ctx.textAlign = 'left';
-    for (const [name, f, tip, color] of active) {
-      const sp = toScreen(tip);
-      ctx.fillStyle = color;
-      ctx.fillText(name.replace(/_/g, ' ') + ' ' + f.toFixed(f < 10 ? 2 : 1) + ' N', sp[0] + 4 * dpr, sp[1]);
+    view.arrowTips = {};
+    for (const a of active) {
+      const L = arrowPx(a.f, state.gain) * dpr;
+      const p0 = toScreen(a.p);
+      const d = [a.n[0], -a.n[1]];
+      const tip = [p0[0] + d[0] * L, p0[1] + d[1] * L];
+      ctx.strokeStyle = a.color; ctx.fillStyle = a.color; ctx.lineWidth = 2.5 * dpr;
+      ctx.beginPath(); ctx.moveTo(p0[0], p0[1]); ctx.lineTo(tip[0], tip[1]); ctx.stroke();
+      const h = 8 * dpr, w = 4 * dpr;
+      ctx.beginPath();
+      ctx.moveTo(tip[0] + d[0] * h, tip[1] + d[1] * h);
+      ctx.lineTo(tip[0] - d[1] * w, tip[1] + d[0] * w);
+      ctx.lineTo(tip[0] + d[1] * w, tip[1] - d[0] * w);
+      ctx.closePath(); ctx.fill();
+      ctx.beginPath(); ctx.arc(p0[0], p0[1], 3 * dpr, 0, 2 * Math.PI); ctx.fill();
+      ctx.fillText(a.name.replace(/_/g, ' ') + ' ' + a.f.toFixed(a.f < 10 ? 2 : 1) + ' N', tip[0] + 6 * dpr, tip[1]);
+      view.arrowTips[a.name] = [(p0[0] + tip[0]) / 2, (p0[1] + tip[1]) / 2];
     }
     // Time, scale bar, arrow legend.
     ctx.fillStyle = '#111';
@@ -310,14 +312,14 @@
     ctx.textAlign = 'left';
     let lx = 10 * dpr;
     const ly = H - 14 * dpr;
-    ctx.fillStyle = '#c0392b'; ctx.strokeStyle = '#c0392b';
+    ctx.fillStyle = '#c0392b'; ctx.strokeStyle = '#c0392b'; ctx.lineWidth = 2 * dpr;
     for (const f of [1, 10, 100]) {
-      const len = arrowMm(f, state.gain) * s;
+      const len = arrowPx(f, state.gain) * dpr;
       ctx.beginPath(); ctx.moveTo(lx, ly); ctx.lineTo(lx + len, ly); ctx.stroke();
       ctx.fillText(f + ' N', lx + len + 3 * dpr, ly);
       lx += len + 40 * dpr;
     }
-    view.canvas.dataset.activeContacts = active.map((a) => a[0]).join(' ');
+    view.canvas.dataset.activeContacts = active.map((a) => a.name).join(' ');
   }
 
   // ---------------------------------------------------------------- plots
@@ -482,7 +484,11 @@
   loopBox.addEventListener('change', () => { state.loop = loopBox.checked; });
   zoomSel.addEventListener('change', () => { views.forEach((v) => fitZoom(v, zoomSel.value)); draw(); });
   gainInput.addEventListener('input', () => { state.gain = parseFloat(gainInput.value); draw(); });
-  scrubber.addEventListener('input', () => { play(false); seek(parseFloat(scrubber.value), true); });
+  scrubber.addEventListener('input', () => {
+    const t = parseFloat(scrubber.value);
+    state.playing = false;
+    seek(t, true);
+  });
   window.addEventListener('resize', () => { views.forEach((v) => fitZoom(v, zoomSel.value)); draw(); });
   window.addEventListener('keydown', (ev) => {
     if (ev.target && ev.target.tagName === 'SELECT') return;
@@ -516,6 +522,8 @@
     events: () => events.slice(), runs: () => RUNS.map((r) => r.name),
     hammerAngle: (k) => { const r = RUNS[k || 0]; const [i, u] = locate(r, state.t); return lerp(seriesOf(r, 'hammer_angle_deg'), i, u); },
     activeContacts: (k) => views[k || 0].canvas.dataset.activeContacts.split(' ').filter(Boolean),
+    arrowTip: (name, k) => (views[k || 0].arrowTips || {})[name] || null,
+    range: () => [tStart, tEnd],
   };
 
   draw();

@@ -1,0 +1,100 @@
+// Opens a real piano report in headless Chromium and checks what a person would:
+// no console error, no network request, Play advances time and the hammer moves, the
+// scrubber and #t= seek to the right frame, the hammer–string arrow shows at string
+// contact, clicking a plot seeks. Saves screenshots for a person to look at.
+//
+// node report.test.mjs REPORT.html SCREENSHOT_DIR STRIKE_TIME_S
+import { chromium } from 'playwright-core';
+import { mkdirSync } from 'node:fs';
+
+const [report, shots, strikeArg] = process.argv.slice(2);
+const strike = parseFloat(strikeArg);
+mkdirSync(shots, { recursive: true });
+const failures = [];
+const check = (ok, what) => { if (!ok) failures.push(what); console.log((ok ? 'ok   ' : 'FAIL ') + what); };
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+  const errors = [];
+  const requests = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('request', (r) => { if (!r.url().startsWith('file://')) requests.push(r.url()); });
+
+  const url = 'file://' + report;
+  const started = Date.now();
+  await page.goto(url);
+  await page.waitForFunction(() => window.pianoReport !== undefined);
+  const openMs = Date.now() - started;
+  console.log('opened in ' + openMs + ' ms');
+  check(openMs < 1000, 'the report opens in under a second (' + openMs + ' ms)');
+  await page.screenshot({ path: shots + '/01-opened.png' });
+
+  const R = (fn, arg) => page.evaluate(fn, arg);
+  // Play advances time and the hammer moves.
+  const a0 = await R(() => window.pianoReport.hammerAngle());
+  await R(() => window.pianoReport.setSpeed(0.1));
+  await page.click('#play');
+  await page.waitForTimeout(600);
+  await page.click('#play');
+  const t1 = await R(() => window.pianoReport.time());
+  const a1 = await R(() => window.pianoReport.hammerAngle());
+  check(t1 > 0.02 && t1 < 0.09, 'Play at 1/10 for 0.6 s advances time by 20-90 ms (' + (t1 * 1e3).toFixed(1) + ' ms)');
+  check(Math.abs(a1 - a0) > 0.5, 'the hammer moves (' + a0.toFixed(2) + '° → ' + a1.toFixed(2) + '°)');
+  check(!(await R(() => window.pianoReport.playing())), 'pause stops the clock');
+
+  // The scrubber seeks.
+  await page.$eval('#scrubber', (e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }, String(strike));
+  const ts = await R(() => window.pianoReport.time());
+  check(Math.abs(ts - strike) < 1e-9, 'the scrubber seeks to ' + strike + ' s (' + ts + ')');
+
+  // #t= seeks, also on hashchange.
+  await R(() => { location.hash = '#t=0.05'; });
+  await page.waitForFunction(() => Math.abs(window.pianoReport.time() - 0.05) < 1e-9, null, { timeout: 2000 }).catch(() => {});
+  check(Math.abs((await R(() => window.pianoReport.time())) - 0.05) < 1e-9, '#t=0.05 seeks on hashchange');
+  const deep = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+  deep.on('pageerror', (e) => errors.push(String(e)));
+  await deep.goto(url + '#t=' + strike);
+  await deep.waitForFunction(() => window.pianoReport !== undefined);
+  check(Math.abs((await deep.evaluate(() => window.pianoReport.time())) - strike) < 1e-9, 'a deep link #t= opens at that time');
+  await deep.close();
+
+  // At string contact the hammer–string arrow is drawn.
+  const during = strike + 0.0004;
+  await R((t) => window.pianoReport.seek(t), during);
+  const active = await R(() => window.pianoReport.activeContacts());
+  check(active.includes('hammer_string'), 'the hammer–string force arrow is drawn at string contact (' + active.join(', ') + ')');
+  const tip = await R(() => window.pianoReport.arrowTip('hammer_string'));
+  const pixel = tip && await page.$eval('#canvas2d-0', (c, p) => Array.from(c.getContext('2d').getImageData(Math.round(p[0]), Math.round(p[1]), 1, 1).data), tip);
+  check(pixel && pixel[0] > 150 && pixel[1] < 110 && pixel[2] < 110, 'the arrow is red on the canvas (' + pixel + ')');
+  await R(() => { document.getElementById('zoom').value = 'string'; document.getElementById('zoom').dispatchEvent(new Event('change')); });
+  await page.screenshot({ path: shots + '/02-string-contact.png' });
+  await R(() => { document.getElementById('zoom').value = 'whole action'; document.getElementById('zoom').dispatchEvent(new Event('change')); });
+  await R((t) => window.pianoReport.seek(t), strike - 0.02);
+  check((await R(() => window.pianoReport.activeContacts())).indexOf('hammer_string') < 0, 'no string arrow 20 ms before the strike');
+
+  // Clicking a plot seeks there.
+  const box = await page.$eval('#plotcanvas-hammer-angle', (c) => { const r = c.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
+  const span = await R(() => { const e = window.pianoReport.range(); return e; });
+  const fraction = 0.5;
+  const margin = 44, right = 22;
+  await page.mouse.click(box[0] + margin + fraction * (box[2] - margin - right), box[1] + box[3] / 2);
+  const tc = await R(() => window.pianoReport.time());
+  const want = span[0] + fraction * (span[1] - span[0]);
+  check(Math.abs(tc - want) < 0.01 * (span[1] - span[0]), 'clicking the middle of a plot seeks to ' + (want * 1e3).toFixed(1) + ' ms (' + (tc * 1e3).toFixed(1) + ' ms)');
+  await page.screenshot({ path: shots + '/03-plot-click.png', fullPage: true });
+
+  check(errors.length === 0, 'no console error (' + errors.join(' | ') + ')');
+  check(requests.length === 0, 'no network request (' + requests.join(' ') + ')');
+} finally {
+  await browser.close();
+}
+if (failures.length) {
+  console.error(failures.length + ' check(s) failed');
+  process.exit(1);
+}
