@@ -39,7 +39,7 @@ fn the_report_works_in_headless_chromium() {
     let root = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("browser");
     let run = root.join("struck");
     let scenario = Scenario::from_toml_str(
-        "model = \"double\"\nduration_s = 0.1\n[input]\nkind = \"touch\"\nstyle = \"struck\"\nfinger_speed_m_s = 1.2\n",
+        "model = \"double\"\nduration_s = 0.3\n[input]\nkind = \"touch\"\nstyle = \"struck\"\nfinger_speed_m_s = 1.2\n",
     )
     .unwrap();
     let params = ActionParams::reference();

@@ -89,6 +89,45 @@ try {
   check(Math.abs(tc - want) < 0.01 * (span[1] - span[0]), 'clicking the middle of a plot seeks to ' + (want * 1e3).toFixed(1) + ' ms (' + (tc * 1e3).toFixed(1) + ' ms)');
   await page.screenshot({ path: shots + '/03-plot-click.png', fullPage: true });
 
+  // The 3D view renders: the canvas holds more than its background.
+  check(await R(() => window.pianoReport.webgl()), 'WebGL is available for the 3D view');
+  const shades = await page.$eval('#canvas3d-0', (c) => {
+    const copy = document.createElement('canvas');
+    copy.width = c.width; copy.height = c.height;
+    const g = copy.getContext('2d');
+    g.drawImage(c, 0, 0);
+    const px = g.getImageData(0, 0, c.width, c.height).data;
+    const seen = new Set();
+    let fg = 0;
+    for (let k = 0; k < px.length; k += 16) {
+      seen.add((px[k] >> 4) + ',' + (px[k + 1] >> 4) + ',' + (px[k + 2] >> 4));
+      if (Math.abs(px[k] - 247) + Math.abs(px[k + 1] - 247) + Math.abs(px[k + 2] - 245) > 30) fg++;
+    }
+    return [seen.size, fg / (px.length / 16)];
+  });
+  check(shades[0] > 20 && shades[1] > 0.03, 'the 3D view is not blank (' + shades[0] + ' shades, ' + (100 * shades[1]).toFixed(1) + ' % drawn)');
+  await page.$eval('#view3d-0', (e) => e.scrollIntoView());
+  await page.screenshot({ path: shots + '/04-3d.png' });
+
+  // Without WebGL the page says so and nothing breaks.
+  const plain = await chromium.launch({
+    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+    args: ['--no-sandbox', '--disable-gpu', '--disable-webgl', '--disable-3d-apis', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+  try {
+    const p2 = await plain.newPage();
+    const errs2 = [];
+    p2.on('pageerror', (e) => errs2.push(String(e)));
+    p2.on('console', (m) => { if (m.type() === 'error') errs2.push(m.text()); });
+    await p2.goto(url);
+    await p2.waitForFunction(() => window.pianoReport !== undefined);
+    const note = await p2.$('#no-webgl-0');
+    check(note !== null && errs2.length === 0, 'without WebGL the 3D view explains itself, no error (' + errs2.join(' | ') + ')');
+  } finally {
+    await plain.close();
+  }
+
   check(errors.length === 0, 'no console error (' + errors.join(' | ') + ')');
   check(requests.length === 0, 'no network request (' + requests.join(' ') + ')');
 } finally {
