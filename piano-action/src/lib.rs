@@ -22,6 +22,7 @@ pub mod drawing;
 mod error;
 pub mod params;
 pub mod pendulum;
+pub mod plot;
 pub mod regulation;
 pub mod report;
 pub mod scenario;

@@ -49,6 +49,22 @@ enum Command {
         #[arg(long)]
         out: Option<std::path::PathBuf>,
     },
+    /// Write a static figure of a run for papers: hammer angle, hammer speed, key depth and
+    /// contact forces against time.
+    Plot {
+        /// A run directory written by `piano simulate`.
+        run: std::path::PathBuf,
+        /// `svg` or `png`.
+        #[arg(long, default_value = "svg")]
+        format: String,
+        /// The file to write (default: figure.svg or figure.png in the run directory);
+        /// an existing file is not overwritten.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+        /// TrueType font for the text (found on the system if not given).
+        #[arg(long)]
+        font: Option<std::path::PathBuf>,
+    },
     /// Write the default parameter file (with its comments and sources) to standard output.
     Params,
     /// Regulate the action like a technician (front-rail punching, capstan, let-off button,
@@ -107,6 +123,28 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+}
+
+fn plot(
+    run: &std::path::Path,
+    format: &str,
+    out: Option<std::path::PathBuf>,
+    font: Option<&std::path::Path>,
+) -> Result<(), String> {
+    let fmt = piano_action::plot::Format::parse(format).map_err(|e| e.to_string())?;
+    let path = match out {
+        Some(p) if p.exists() => {
+            return Err(format!(
+                "{} exists; remove it or choose another --out",
+                p.display()
+            ));
+        }
+        Some(p) => p,
+        None => run.join(format!("figure.{format}")),
+    };
+    piano_action::plot::plot_run(run, fmt, &path, font).map_err(|e| e.to_string())?;
+    println!("figure: {}", path.display());
+    Ok(())
 }
 
 /// Writes the report of `runs` to `out` and prints its path.
@@ -483,6 +521,12 @@ fn main() -> ExitCode {
                 out,
                 report,
             } => simulate_scenario(&params, &scenario, &out, report),
+            Command::Plot {
+                run,
+                format,
+                out,
+                font,
+            } => plot(&run, &format, out, font.as_deref()),
             Command::Report { runs, out } => {
                 let out = out.unwrap_or_else(|| runs[0].join("report.html"));
                 write_report(&runs, &out)

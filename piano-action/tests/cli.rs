@@ -330,3 +330,54 @@ fn sweep_writes_one_row_per_run_and_keeps_existing_files() {
     assert!(!ok && err.contains("--touch"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn report_and_plot_write_their_files_and_keep_yours() {
+    let dir = std::env::temp_dir().join(format!("piano-report-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = dir.join("s.toml");
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.05\n[input]\nkind = \"force\"\nforce_n = 20.0\n",
+    )
+    .unwrap();
+    let run = dir.join("run");
+    let (ok, out, err) = piano(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--report",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("report: ") && run.join("report.html").exists(),
+        "{out}"
+    );
+    let other = dir.join("mine.html");
+    std::fs::write(&other, "mine").unwrap();
+    let (ok, _, err) = piano(&[
+        "report",
+        run.to_str().unwrap(),
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("not a piano report"), "{err}");
+    assert_eq!(std::fs::read_to_string(&other).unwrap(), "mine");
+    let (ok, _, err) = piano(&[
+        "plot",
+        run.to_str().unwrap(),
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("exists"), "{err}");
+    let (ok, out, err) = piano(&["plot", run.to_str().unwrap(), "--format", "png"]);
+    if ok {
+        assert!(run.join("figure.png").exists(), "{out}");
+    } else {
+        assert!(err.contains("--font"), "{err}");
+    }
+    let (ok, _, err) = piano(&["plot", run.to_str().unwrap(), "--format", "gif"]);
+    assert!(!ok && err.contains("--format"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
