@@ -73,10 +73,13 @@ fn register_font(font: Option<&Path>) -> Result<()> {
     })
 }
 
-/// One panel: title, unit and lines (label, colour, points in ms and unit).
+/// Points of a line: time (ms) and value.
+type Points = Vec<(f64, f64)>;
+
+/// One panel: title and lines (label, colour, points).
 struct Panel {
     title: String,
-    lines: Vec<(String, RGBColor, Vec<(f64, f64)>)>,
+    lines: Vec<(String, RGBColor, Points)>,
 }
 
 const LINE_COLORS: [RGBColor; 8] = [
@@ -118,7 +121,7 @@ fn panels(run: &Value) -> Vec<Panel> {
         lines: vec![(String::new(), LINE_COLORS[0], series(id))],
     };
     // Contact forces: those that carry load at some time, largest peak first.
-    let mut forces: Vec<(String, Vec<(f64, f64)>, f64)> = run["contacts"]
+    let mut forces: Vec<(String, Points, f64)> = run["contacts"]
         .as_object()
         .map(|m| {
             m.iter()

@@ -15,13 +15,10 @@ fn a_run_is_drawn_as_svg_and_png() {
     let run = scenario.run(&params).unwrap();
     write_run_dir(&dir, &scenario, &params, &run).unwrap();
     let svg = dir.join("figure.svg");
-    match plot_run(&dir, Format::Svg, &svg, None) {
-        Err(e) => {
-            // Without any font on the machine the error says how to give one.
-            assert!(e.to_string().contains("--font"), "{e}");
-            return;
-        }
-        Ok(()) => {}
+    if let Err(e) = plot_run(&dir, Format::Svg, &svg, None) {
+        // Without any font on the machine the error says how to give one.
+        assert!(e.to_string().contains("--font"), "{e}");
+        return;
     }
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg"), "{}", &text[..40]);
