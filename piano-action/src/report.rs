@@ -273,6 +273,7 @@ pub fn run_data(dir: &Path) -> Result<Value> {
             )
         })
         .collect();
+    let measured = read_measured(dir, &series)?;
     let series_json: Vec<Value> = series
         .into_iter()
         .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
@@ -293,7 +294,77 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         "events": read_json(dir, "events.json")?,
         "summary": read_json(dir, "summary.json")?,
         "zoom": zoom,
+        "measured": measured,
     }))
+}
+
+/// The measured data of a run, if its directory has `measured.csv`: a `time_s` column and
+/// any of the plotted series by their ids (`hammer_angle_deg`, `hammer_speed_m_s`,
+/// `key_depth_mm`, ...), overlaid on the plots as points. Empty cells are gaps.
+fn read_measured(dir: &Path, series: &[(&str, &str, Vec<f64>)]) -> Result<Value> {
+    let path = dir.join("measured.csv");
+    if !path.exists() {
+        return Ok(Value::Null);
+    }
+    let text = read(dir, "measured.csv")?;
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| bad(dir, "measured.csv is empty".into()))?
+        .split(',')
+        .map(str::trim)
+        .collect();
+    if header.first() != Some(&"time_s") {
+        return Err(bad(
+            dir,
+            "measured.csv: the first column must be time_s".into(),
+        ));
+    }
+    let known: Vec<&str> = series.iter().map(|s| s.0).collect();
+    for h in &header[1..] {
+        if !known.contains(h) {
+            return Err(bad(
+                dir,
+                format!(
+                    "measured.csv: unknown column '{h}' (known: {})",
+                    known.join(", ")
+                ),
+            ));
+        }
+    }
+    let mut columns: Vec<(Vec<f64>, Vec<f64>)> = vec![Default::default(); header.len() - 1];
+    for (i, line) in lines.enumerate() {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let number = |c: &str| -> Result<Option<f64>> {
+            if c.is_empty() {
+                return Ok(None);
+            }
+            c.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .map(Some)
+                .ok_or_else(|| {
+                    bad(
+                        dir,
+                        format!("measured.csv line {}: '{c}' is not a number", i + 2),
+                    )
+                })
+        };
+        let t = number(cells.first().copied().unwrap_or(""))?
+            .ok_or_else(|| bad(dir, format!("measured.csv line {}: no time", i + 2)))?;
+        for (k, col) in columns.iter_mut().enumerate() {
+            if let Some(v) = number(cells.get(k + 1).copied().unwrap_or(""))? {
+                col.0.push(r(t, 6));
+                col.1.push(r(v, 4));
+            }
+        }
+    }
+    Ok(header[1..]
+        .iter()
+        .zip(columns)
+        .map(|(h, (t, v))| (h.to_string(), json!({"t": t, "v": v})))
+        .collect::<serde_json::Map<String, Value>>()
+        .into())
 }
 
 /// Embeds `value` as JSON inside a `<script>` element: `</` is escaped so no string in the

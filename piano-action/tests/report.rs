@@ -154,3 +154,39 @@ fn broken_run_directories_are_named() {
         Err(PianoError::Params { field, .. }) if field == "RUN_DIR"
     ));
 }
+
+#[test]
+fn measured_data_beside_a_run_are_embedded_for_overlay() {
+    let dir = run_dir("measured", STRUCK);
+    std::fs::write(
+        dir.join("measured.csv"),
+        "time_s,hammer_angle_deg,key_depth_mm\n0.0,0.1,\n0.01,2.5,1.0\n0.02,14.0,\n",
+    )
+    .unwrap();
+    let data = embedded(&report_html(std::slice::from_ref(&dir)).unwrap());
+    let m = &data["runs"][0]["measured"];
+    assert_eq!(
+        m["hammer_angle_deg"]["t"],
+        serde_json::json!([0.0, 0.01, 0.02])
+    );
+    assert_eq!(
+        m["hammer_angle_deg"]["v"],
+        serde_json::json!([0.1, 2.5, 14.0])
+    );
+    // Empty cells are gaps.
+    assert_eq!(m["key_depth_mm"]["t"], serde_json::json!([0.01]));
+    // A column that is not a plotted quantity is refused by name.
+    std::fs::write(
+        dir.join("measured.csv"),
+        "time_s,hammer_velocity\n0.0,1.0\n",
+    )
+    .unwrap();
+    let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
+    assert!(
+        e.to_string().contains("unknown column 'hammer_velocity'"),
+        "{e}"
+    );
+    std::fs::write(dir.join("measured.csv"), "time_s,key_depth_mm\n0.0,deep\n").unwrap();
+    let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
+    assert!(e.to_string().contains("measured.csv line 2"), "{e}");
+}

@@ -555,9 +555,9 @@
   const plotsBox = el('section', { id: 'plots' }, main);
   const plotDefs = [];
   const seriesOf = (run, id) => (run.series.find((s) => s.id === id) || {}).values;
-  plotDefs.push({ id: 'hammer-angle', title: 'Hammer angle (°)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'hammer_angle_deg'), color: RUN_COLORS[k % 6] })) });
-  plotDefs.push({ id: 'hammer-speed', title: 'Hammer speed at the strike point (m/s)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'hammer_speed_m_s'), color: RUN_COLORS[k % 6] })) });
-  plotDefs.push({ id: 'key-depth', title: 'Key-front depth below rest (mm)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'key_depth_mm'), color: RUN_COLORS[k % 6] })) });
+  plotDefs.push({ id: 'hammer-angle', title: 'Hammer angle (°)', lines: RUNS.map((r, k) => ({ run: k, id: 'hammer_angle_deg', label: r.name, values: seriesOf(r, 'hammer_angle_deg'), color: RUN_COLORS[k % 6] })) });
+  plotDefs.push({ id: 'hammer-speed', title: 'Hammer speed at the strike point (m/s)', lines: RUNS.map((r, k) => ({ run: k, id: 'hammer_speed_m_s', label: r.name, values: seriesOf(r, 'hammer_speed_m_s'), color: RUN_COLORS[k % 6] })) });
+  plotDefs.push({ id: 'key-depth', title: 'Key-front depth below rest (mm)', lines: RUNS.map((r, k) => ({ run: k, id: 'key_depth_mm', label: r.name, values: seriesOf(r, 'key_depth_mm'), color: RUN_COLORS[k % 6] })) });
   const forceLines = [];
   RUNS.forEach((r, k) => {
     for (const [name, c] of Object.entries(r.contacts)) {
@@ -571,7 +571,7 @@
     { run: k, label: 'gravity ' + r.name, values: seriesOf(r, 'gravity_mj'), color: RUN_COLORS[k % 6], dash: [5, 3] },
   ]) });
   if (RUNS.some((r) => seriesOf(r, 'key_drive_force_n'))) {
-    plotDefs.push({ id: 'hand-force', title: 'Hand force at the key front (N)', lines: RUNS.map((r, k) => ({ run: k, label: r.name, values: seriesOf(r, 'key_drive_force_n'), color: RUN_COLORS[k % 6] })).filter((l) => l.values) });
+    plotDefs.push({ id: 'hand-force', title: 'Hand force at the key front (N)', lines: RUNS.map((r, k) => ({ run: k, id: 'key_drive_force_n', label: r.name, values: seriesOf(r, 'key_drive_force_n'), color: RUN_COLORS[k % 6] })).filter((l) => l.values) });
   }
   const plots = plotDefs.map((def) => {
     const box = el('div', { class: 'plot', id: 'plot-' + def.id }, plotsBox);
@@ -584,7 +584,14 @@
       s.appendChild(document.createTextNode(l.label));
     });
     let lo = Infinity, hi = -Infinity;
-    for (const l of def.lines) for (const v of l.values || []) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    for (const l of def.lines) {
+      const m = l.id && RUNS[l.run].measured && RUNS[l.run].measured[l.id];
+      for (const v of (l.values || []).concat(m ? m.v : [])) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+      if (m && m.t.length) {
+        const s = el('span', {}, legend, ' ● measured ' + RUNS[l.run].name);
+        s.style.color = l.color;
+      }
+    }
     if (!isFinite(lo)) { lo = 0; hi = 1; }
     if (hi - lo < 1e-9) { hi += 1; lo -= 1; }
     const pad = 0.06 * (hi - lo);
@@ -639,6 +646,15 @@
       l.values.forEach((v, k) => (k ? ctx.lineTo(X(ts[k]), Y(v)) : ctx.moveTo(X(ts[k]), Y(v))));
       ctx.stroke();
       ctx.setLineDash([]);
+    }
+    // Measured data of the same quantity, as points.
+    for (const l of def.lines) {
+      const m = l.id && RUNS[l.run].measured && RUNS[l.run].measured[l.id];
+      if (!m) continue;
+      ctx.fillStyle = l.color;
+      m.t.forEach((t, k) => {
+        ctx.beginPath(); ctx.arc(X(t), Y(m.v[k]), 2.2 * dpr, 0, 2 * Math.PI); ctx.fill();
+      });
     }
     ctx.strokeStyle = '#000'; ctx.lineWidth = 1.2 * dpr;
     ctx.beginPath(); ctx.moveTo(X(state.t), top); ctx.lineTo(X(state.t), H - bottom); ctx.stroke();
