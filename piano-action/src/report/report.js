@@ -770,6 +770,9 @@
     activeContacts: (k) => views[k || 0].canvas.dataset.activeContacts.split(' ').filter(Boolean),
     arrowTip: (name, k) => (views[k || 0].arrowTips || {})[name] || null,
     range: () => [tStart, tEnd],
+    frame: (k) => locate(RUNS[k || 0], state.t)[0],
+    frameTime: (i, k) => RUNS[k || 0].t[i],
+    angleAtFrame: (i, k) => seriesOf(RUNS[k || 0], 'hammer_angle_deg')[i],
     webgl: (k) => !!views3d[k || 0].gl,
   };
 

@@ -53,10 +53,16 @@ try {
   const ts = await R(() => window.pianoReport.time());
   check(Math.abs(ts - strike) < 1e-9, 'the scrubber seeks to ' + strike + ' s (' + ts + ')');
 
+  // ... to the right frame: frame 40 shows frame 40's hammer.
+  const t40 = await R(() => window.pianoReport.frameTime(40));
+  await page.$eval('#scrubber', (e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }, String(t40));
+  const [f40, a40, want40] = await R(() => [window.pianoReport.frame(), window.pianoReport.hammerAngle(), window.pianoReport.angleAtFrame(40)]);
+  check(f40 === 40 && Math.abs(a40 - want40) < 1e-9, 'the scrubber shows frame 40 and its hammer angle (' + f40 + ', ' + a40 + '°)');
+
   // #t= seeks, also on hashchange.
   await R(() => { location.hash = '#t=0.05'; });
   await page.waitForFunction(() => Math.abs(window.pianoReport.time() - 0.05) < 1e-9, null, { timeout: 2000 }).catch(() => {});
-  check(Math.abs((await R(() => window.pianoReport.time())) - 0.05) < 1e-9, '#t=0.05 seeks on hashchange');
+  check(Math.abs((await R(() => window.pianoReport.time())) - 0.05) < 1e-9 && (await R(() => window.pianoReport.frame())) === 50, '#t=0.05 seeks on hashchange, to frame 50');
   const deep = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
   deep.on('pageerror', (e) => errors.push(String(e)));
   await deep.goto(url + '#t=' + strike);
