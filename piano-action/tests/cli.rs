@@ -381,3 +381,20 @@ fn report_and_plot_write_their_files_and_keep_yours() {
     assert!(!ok && err.contains("--format"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_demo_prints_its_table_and_writes_a_report() {
+    let (ok, out, err) = piano(&[]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("pressed 10 N") && out.contains("struck 0.80 m/s"),
+        "{out}"
+    );
+    let path = out
+        .lines()
+        .find_map(|l| l.strip_prefix("report: "))
+        .expect("the demo prints the report's path");
+    let html = std::fs::read_to_string(path).unwrap();
+    assert!(html.contains(r#"id="report-data""#));
+    assert!(html.contains("pressed touch 10 N") && html.contains("struck touch 0.8 m/s"));
+}
