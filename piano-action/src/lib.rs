@@ -13,7 +13,8 @@
 //! ([`regulation::measure`], [`regulation::regulate`]); the static touchweight
 //! ([`touchweight::measure`]); the hammer swing test ([`pendulum`]); scenarios and run
 //! directories with drawings to scale ([`scenario`], [`drawing`]); parallel sweeps over
-//! touch levels ([`sweep`]).
+//! touch levels ([`sweep`]); the interactive HTML report ([`report`]) and static figures
+//! ([`plot`]).
 //!
 #![warn(missing_docs)]
 

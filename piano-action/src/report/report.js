@@ -97,10 +97,23 @@
   }, timeline);
   const marks = el('div', { id: 'event-marks' }, timeline);
   const eventList = el('div', { id: 'event-list' }, timeline);
-  // Events of all runs, in time order, each tagged with its run.
-  const events = [];
-  RUNS.forEach((run, k) => (run.events || []).forEach((e) => events.push({ name: e.name, t: e.time_s, run: k })));
-  events.sort((a, b) => a.t - b.t);
+  // Events of all runs, in time order, each tagged with its run. The releases, and a
+  // contact chattering (the same event again within 5 ms), are left out unless asked for.
+  const allEvents = [];
+  RUNS.forEach((run, k) => (run.events || []).forEach((e) => allEvents.push({ name: e.name, t: e.time_s, run: k })));
+  allEvents.sort((a, b) => a.t - b.t);
+  const MINOR = /(_release|_lift)$/;
+  const keyEvents = allEvents.filter((e, k) => {
+    if (MINOR.test(e.name)) return false;
+    const prev = allEvents.slice(0, k).reverse().find((p) => p.run === e.run && p.name === e.name);
+    return !prev || e.t - prev.t > 0.005;
+  });
+  const showAll = new URLSearchParams(location.search).has('all-events');
+  const events = showAll ? allEvents : keyEvents;
+  if (events.length < allEvents.length) {
+    el('span', { class: 'legend' }, timeline,
+      (allEvents.length - events.length) + ' minor events (releases, chatter within 5 ms) not listed; open the page with ?all-events for all of them.');
+  }
   const eventButtons = events.map((e) => {
     const pos = (100 * (e.t - tStart)) / (tEnd - tStart || 1);
     const m = el('span', { title: e.name + ' at ' + fmtMs(e.t) + (RUNS.length > 1 ? ' (' + RUNS[e.run].name + ')' : '') }, marks);
