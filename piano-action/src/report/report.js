@@ -277,18 +277,19 @@
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
     ctx.textBaseline = 'middle';
-    if (view.halfWidth < 120) {
-      ctx.fillStyle = '#333';
-      for (const part of run.scene.parts) {
-        const [a, x, y] = part.frame ? carryAt(run, part.frame, i, u) : [0, 0, 0];
-        for (const l of part.labels) {
-          const q = [x + Math.cos(a) * l.anchor[0] - Math.sin(a) * l.anchor[1], y + Math.sin(a) * l.anchor[0] + Math.cos(a) * l.anchor[1]];
-          const sp = toScreen([q[0] + l.offset[0], q[1] + l.offset[1]]);
-          ctx.textAlign = l.align === 'middle' ? 'center' : l.align === 'end' ? 'right' : 'left';
-          ctx.fillText(l.text, sp[0], sp[1]);
-        }
+    // Part names, smaller when the whole action is in view.
+    ctx.font = ((view.halfWidth < 120 ? 11 : 9.5) * dpr) + 'px system-ui, sans-serif';
+    ctx.fillStyle = '#555';
+    for (const part of run.scene.parts) {
+      const [a, x, y] = part.frame ? carryAt(run, part.frame, i, u) : [0, 0, 0];
+      for (const l of part.labels) {
+        const q = [x + Math.cos(a) * l.anchor[0] - Math.sin(a) * l.anchor[1], y + Math.sin(a) * l.anchor[0] + Math.cos(a) * l.anchor[1]];
+        const sp = toScreen([q[0] + l.offset[0], q[1] + l.offset[1]]);
+        ctx.textAlign = l.align === 'middle' ? 'center' : l.align === 'end' ? 'right' : 'left';
+        ctx.fillText(l.text, sp[0], sp[1]);
       }
     }
+    ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
     // Force arrows on the moving part, log scaled in screen pixels so they read at any
     // zoom: 0.1 N, 1 N, 10 N and 100 N are equal steps (see the legend).
     ctx.textAlign = 'left';
