@@ -492,7 +492,7 @@
       color: gl.getUniformLocation(prog, 'color'), light: gl.getUniformLocation(prog, 'light'),
     };
     view.target = [(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2, 0];
-    view.distance = 1.1 * Math.max(b.x1 - b.x0, b.y1 - b.y0);
+    view.distance = 1.3 * Math.max(b.x1 - b.x0, b.y1 - b.y0);
     view.azimuth = -0.42;
     view.elevation = 0.22;
     return true;
