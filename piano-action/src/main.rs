@@ -3,7 +3,7 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use piano_action::{ActionParams, Finger, Input, ModelKind, TouchStyle, simulate};
 
 /// Grand piano action simulator.
@@ -83,36 +83,7 @@ enum Command {
     },
     /// Play one keystroke per level, in parallel on all cores, and write one CSV row per
     /// run (hammer speed, string contact, travel time, key bottom, check, ...).
-    Sweep {
-        /// What to vary: `force` (constant key-front force, N), `pressed` (peak force of a
-        /// pressed touch, N) or `struck` (finger speed, m/s).
-        #[arg(long, default_value = "struck")]
-        touch: String,
-        /// First level (default: 1 N, 0.7 N or 0.08 m/s).
-        #[arg(long)]
-        from: Option<f64>,
-        /// Last level (default: 40 N, 50 N or 2 m/s).
-        #[arg(long)]
-        to: Option<f64>,
-        /// Number of runs.
-        #[arg(long, default_value_t = 100)]
-        runs: usize,
-        /// Space the levels evenly rather than on a log scale.
-        #[arg(long)]
-        linear: bool,
-        /// Which model.
-        #[arg(long, default_value = "double")]
-        model: String,
-        /// Simulated time per run (s).
-        #[arg(long, default_value_t = 0.3)]
-        duration: f64,
-        /// Worker threads (default: one per core).
-        #[arg(long)]
-        jobs: Option<usize>,
-        /// The CSV file to write (refuses to overwrite a file).
-        #[arg(long)]
-        out: std::path::PathBuf,
-    },
+    Sweep(SweepArgs),
     /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
     /// from a slow simulated key descent and ascent.
     Touchweight {
@@ -195,15 +166,35 @@ fn simulate_scenario(
 }
 
 /// The options of `piano sweep`.
+#[derive(Args)]
 struct SweepArgs {
+    /// What to vary: `force` (constant key-front force, N), `pressed` (peak force of a
+    /// pressed touch, N) or `struck` (finger speed, m/s).
+    #[arg(long, default_value = "struck")]
     touch: String,
+    /// First level (default: 1 N, 0.7 N or 0.08 m/s).
+    #[arg(long)]
     from: Option<f64>,
+    /// Last level (default: 40 N, 50 N or 2 m/s).
+    #[arg(long)]
     to: Option<f64>,
+    /// Number of runs.
+    #[arg(long, default_value_t = 100)]
     runs: usize,
+    /// Space the levels evenly rather than on a log scale.
+    #[arg(long)]
     linear: bool,
+    /// Which model.
+    #[arg(long, default_value = "double")]
     model: String,
+    /// Simulated time per run (s).
+    #[arg(long, default_value_t = 0.3)]
     duration: f64,
+    /// Worker threads (default: one per core).
+    #[arg(long)]
     jobs: Option<usize>,
+    /// The CSV file to write (refuses to overwrite a file).
+    #[arg(long)]
     out: std::path::PathBuf,
 }
 
@@ -531,30 +522,7 @@ fn main() -> ExitCode {
                 let out = out.unwrap_or_else(|| runs[0].join("report.html"));
                 write_report(&runs, &out)
             }
-            Command::Sweep {
-                touch,
-                from,
-                to,
-                runs,
-                linear,
-                model,
-                duration,
-                jobs,
-                out,
-            } => sweep(
-                &params,
-                SweepArgs {
-                    touch,
-                    from,
-                    to,
-                    runs,
-                    linear,
-                    model,
-                    duration,
-                    jobs,
-                    out,
-                },
-            ),
+            Command::Sweep(args) => sweep(&params, args),
             Command::Params => {
                 use std::io::Write;
                 let _ = std::io::stdout()

@@ -93,8 +93,9 @@ const LINE_COLORS: [RGBColor; 8] = [
     RGBColor(183, 149, 11),
 ];
 
-fn panels(run: &Value) -> Vec<Panel> {
-    let t: Vec<f64> = run["t"]
+/// The run's output times (ms).
+fn times_ms(run: &Value) -> Vec<f64> {
+    run["t"]
         .as_array()
         .map(|a| {
             a.iter()
@@ -102,7 +103,11 @@ fn panels(run: &Value) -> Vec<Panel> {
                 .map(|t| t * 1e3)
                 .collect()
         })
-        .unwrap_or_default();
+        .unwrap_or_default()
+}
+
+fn panels(run: &Value) -> Vec<Panel> {
+    let t = times_ms(run);
     let series = |id: &str| -> Vec<(f64, f64)> {
         run["series"]
             .as_array()
@@ -168,15 +173,7 @@ fn draw<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err)?;
     let title = run["title"].as_str().unwrap_or("run");
     let root = root.titled(title, ("sans-serif", 26)).map_err(err)?;
-    let t: Vec<f64> = run["t"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(Value::as_f64)
-                .map(|t| t * 1e3)
-                .collect()
-        })
-        .unwrap_or_default();
+    let t = times_ms(run);
     let (t0, t1) = (
         t.first().copied().unwrap_or(0.0),
         t.last()
