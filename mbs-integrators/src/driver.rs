@@ -52,6 +52,22 @@ pub fn solve_with_events(
     opts: &Options,
     handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
 ) -> Result<Solution> {
+    solve_observed(sys, method, t0, y0, t_end, opts, handler, &mut |_| {})
+}
+
+/// Integrates like [`solve_with_events`], calling `progress` with the time reached after
+/// every accepted step (to drive a progress bar; it must be cheap).
+#[allow(clippy::too_many_arguments)]
+pub fn solve_observed(
+    sys: &mut dyn OdeSystem,
+    method: Method,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    opts: &Options,
+    handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Solution> {
     opts.validate(method)?;
     let n = sys.len();
     if y0.len() != n {
@@ -96,6 +112,7 @@ pub fn solve_with_events(
         }
         stepper.step(run.sys, t_end, &mut run.stats)?;
         let t_reached = stepper.t();
+        progress(t_reached);
         match run.scan_events(stepper.as_ref(), handler)? {
             None => {
                 run.output_until(stepper.as_ref(), t_reached, true);

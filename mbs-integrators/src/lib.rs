@@ -60,7 +60,7 @@ mod solution;
 mod stepper;
 mod trbdf2;
 
-pub use driver::{solve, solve_with_events};
+pub use driver::{solve, solve_observed, solve_with_events};
 pub use error::{IntegratorError, Result, SystemError};
 #[cfg(feature = "mbs-core")]
 pub use multibody::MultibodyOde;

@@ -24,7 +24,7 @@ use mbs_contact::{Contact, ContactSide, Shape};
 use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::elements::{FrictionLaw, JointLimit, JointSpringDamper, PivotFriction, SpringLaw};
 use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System, TimeFunction};
-use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_with_events};
+use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_observed};
 
 use crate::error::Result;
 use crate::params::{ActionParams, ContactParams};
@@ -151,13 +151,13 @@ impl Action {
                 && pr.height_mm.is_finite()
                 && (0.0..=500.0).contains(&pr.height_mm))
         {
-            return Err(crate::PianoError::Params {
-                field: "input".into(),
-                message: format!(
+            return Err(crate::PianoError::scenario(
+                "input",
+                format!(
                     "the mass must be positive and its height 0-500 mm, got {} kg at {} mm",
                     pr.mass_kg, pr.height_mm
                 ),
-            });
+            ));
         }
         let p = params;
         let (k, w, j, r, h) = (&p.key, &p.wippen, &p.jack, &p.repetition_lever, &p.hammer);
@@ -579,6 +579,19 @@ impl Action {
         max_step: f64,
         output_step: Option<f64>,
     ) -> Result<Solution> {
+        self.integrate_observed(x0, t_end, max_step, output_step, &mut |_| {})
+    }
+
+    /// Integrates like [`Action::integrate`], calling `progress` with the simulated time
+    /// after every step (for a progress bar).
+    pub fn integrate_observed(
+        &self,
+        x0: &[f64],
+        t_end: f64,
+        max_step: f64,
+        output_step: Option<f64>,
+        progress: &mut dyn FnMut(f64),
+    ) -> Result<Solution> {
         let opts = Options {
             max_step,
             output_step,
@@ -588,7 +601,7 @@ impl Action {
                 self.params.numerics.absolute_tolerance,
             )
         };
-        solve_with_events(
+        solve_observed(
             &mut MultibodyOde::new(&self.system),
             Method::TrBdf2,
             0.0,
@@ -596,6 +609,7 @@ impl Action {
             t_end,
             &opts,
             &mut |_, _| EventAction::Record,
+            progress,
         )
         .map_err(|e| crate::PianoError::Simulation(e.to_string()))
     }

@@ -21,6 +21,7 @@
 mod action;
 pub mod drawing;
 mod error;
+pub mod measured;
 pub mod params;
 pub mod pendulum;
 pub mod plot;
@@ -29,10 +30,11 @@ pub mod report;
 pub mod scenario;
 pub mod simulate;
 pub mod sweep;
+pub mod toml_lines;
 pub mod touchweight;
 
 pub use action::{Action, ModelKind, Presser};
 pub use drawing::action_svg;
-pub use error::{PianoError, Result};
+pub use error::{InputError, InputKind, PianoError, Result};
 pub use params::ActionParams;
 pub use simulate::{Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate};

@@ -37,6 +37,10 @@ enum Command {
         /// Also write the interactive report, DIR/report.html.
         #[arg(long)]
         report: bool,
+        /// Replace an earlier run in DIR (only the files a run writes are removed; your
+        /// own files, such as measured.csv, stay).
+        #[arg(long)]
+        force: bool,
     },
     /// Write the interactive report of one or more run directories: one self-contained
     /// HTML page replaying them in slow motion, to scale, with contact forces, events and
@@ -48,6 +52,9 @@ enum Command {
         /// The HTML file to write (default: report.html in the first run directory).
         #[arg(long)]
         out: Option<std::path::PathBuf>,
+        /// Replace an existing report (a file that is not a report is never replaced).
+        #[arg(long)]
+        force: bool,
     },
     /// Write a static figure of a run for papers: hammer angle, hammer speed, key depth and
     /// contact forces against time.
@@ -64,6 +71,9 @@ enum Command {
         /// TrueType font for the text (found on the system if not given).
         #[arg(long)]
         font: Option<std::path::PathBuf>,
+        /// Replace an existing figure.
+        #[arg(long)]
+        force: bool,
     },
     /// Write the default parameter file (with its comments and sources) to standard output.
     Params,
@@ -101,26 +111,28 @@ fn plot(
     format: &str,
     out: Option<std::path::PathBuf>,
     font: Option<&std::path::Path>,
+    force: bool,
 ) -> Result<(), String> {
     let fmt = piano_action::plot::Format::parse(format).map_err(|e| e.to_string())?;
-    let path = match out {
-        Some(p) if p.exists() => {
-            return Err(format!(
-                "{} exists; remove it or choose another --out",
-                p.display()
-            ));
-        }
-        Some(p) => p,
-        None => run.join(format!("figure.{format}")),
-    };
+    let path = out.unwrap_or_else(|| run.join(format!("figure.{format}")));
+    if path.exists() && !force {
+        return Err(format!(
+            "{}: exists; choose another --out, or pass --force to replace it",
+            path.display()
+        ));
+    }
     piano_action::plot::plot_run(run, fmt, &path, font).map_err(|e| e.to_string())?;
     println!("figure: {}", path.display());
     Ok(())
 }
 
 /// Writes the report of `runs` to `out` and prints its path.
-fn write_report(runs: &[std::path::PathBuf], out: &std::path::Path) -> Result<(), String> {
-    piano_action::report::write_report(runs, out).map_err(|e| e.to_string())?;
+fn write_report(
+    runs: &[std::path::PathBuf],
+    out: &std::path::Path,
+    replace: bool,
+) -> Result<(), String> {
+    piano_action::report::write_report(runs, out, replace).map_err(|e| e.to_string())?;
     println!("report: {}", out.display());
     Ok(())
 }
@@ -130,9 +142,14 @@ fn simulate_scenario(
     path: &std::path::Path,
     out: &std::path::Path,
     report: bool,
+    force: bool,
 ) -> Result<(), String> {
-    use piano_action::scenario::{InputSpec, Scenario, write_pendulum_dir, write_run_dir};
+    use piano_action::scenario::{
+        InputSpec, Scenario, prepare_run_dir, write_pendulum_dir, write_run_dir,
+    };
     let scenario = Scenario::load(path).map_err(|e| e.to_string())?;
+    // Refuse (or clear) an earlier run before spending time on this one.
+    prepare_run_dir(out, force).map_err(|e| e.to_string())?;
     if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
         let swing = piano_action::pendulum::swing(params, release_angle_deg, scenario.duration_s)
             .map_err(|e| format!("{}: {e}", path.display()))?;
@@ -148,7 +165,11 @@ fn simulate_scenario(
         }
         return Ok(());
     }
-    let run = scenario.run(params).map_err(|e| e.to_string())?;
+    let mut progress = Progress::new(scenario.duration_s);
+    let run = scenario
+        .run_observed(params, &mut |t| progress.update(t))
+        .map_err(|e| e.to_string())?;
+    progress.finish();
     write_run_dir(out, &scenario, params, &run).map_err(|e| e.to_string())?;
     for s in &run.strikes {
         println!(
@@ -160,9 +181,53 @@ fn simulate_scenario(
     }
     println!("run directory: {}", out.display());
     if report {
-        write_report(&[out.to_path_buf()], &out.join("report.html"))?;
+        write_report(&[out.to_path_buf()], &out.join("report.html"), false)?;
     }
     Ok(())
+}
+
+/// A progress bar for one simulation, on standard error: drawn only on a terminal, and only
+/// once the run has taken more than a second (a keystroke takes milliseconds).
+struct Progress {
+    bar: indicatif::ProgressBar,
+    start: std::time::Instant,
+    shown: bool,
+}
+
+impl Progress {
+    fn new(duration_s: f64) -> Self {
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some((duration_s * 1e3).ceil() as u64),
+            indicatif::ProgressDrawTarget::hidden(),
+        );
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} ms simulated, {elapsed} elapsed, about {eta} to go",
+        ) {
+            bar.set_style(style);
+        }
+        Progress {
+            bar,
+            start: std::time::Instant::now(),
+            shown: false,
+        }
+    }
+
+    /// The simulation has reached `t_s`.
+    fn update(&mut self, t_s: f64) {
+        if !self.shown {
+            if self.start.elapsed().as_secs_f64() < 1.0 {
+                return;
+            }
+            self.shown = true;
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        self.bar.set_position((t_s * 1e3) as u64);
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
 }
 
 /// The options of `piano sweep`.
@@ -173,10 +238,10 @@ struct SweepArgs {
     #[arg(long, default_value = "struck")]
     touch: String,
     /// First level (default: 1 N, 0.7 N or 0.08 m/s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     from: Option<f64>,
     /// Last level (default: 40 N, 50 N or 2 m/s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     to: Option<f64>,
     /// Number of runs.
     #[arg(long, default_value_t = 100)]
@@ -188,7 +253,7 @@ struct SweepArgs {
     #[arg(long, default_value = "double")]
     model: String,
     /// Simulated time per run (s).
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     duration: f64,
     /// Worker threads (default: one per core).
     #[arg(long)]
@@ -196,6 +261,9 @@ struct SweepArgs {
     /// The CSV file to write (refuses to overwrite a file).
     #[arg(long)]
     out: std::path::PathBuf,
+    /// Replace an existing CSV file.
+    #[arg(long)]
+    force: bool,
 }
 
 fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
@@ -216,12 +284,18 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
         SweepKind::Struck => (0.08, 2.0),
     };
     let model = model_kind(&a.model)?;
-    if !(a.duration.is_finite() && a.duration > 0.0) {
-        return Err(format!("--duration: must be positive, got {}", a.duration));
+    piano_action::simulate::check_duration(a.duration, 1e-3).map_err(|e| {
+        format!(
+            "option --duration: {}",
+            e.as_input().map_or(e.to_string(), |i| i.message.clone())
+        )
+    })?;
+    if a.jobs == Some(0) {
+        return Err("option --jobs: needs at least one worker thread".into());
     }
-    if a.out.exists() {
+    if a.out.exists() && !a.force {
         return Err(format!(
-            "{} exists; remove it or choose another --out",
+            "{}: exists; choose another --out, or pass --force to replace it",
             a.out.display()
         ));
     }
@@ -278,7 +352,9 @@ fn model_kind(name: &str) -> Result<ModelKind, String> {
     ModelKind::ALL
         .into_iter()
         .find(|k| k.name() == name)
-        .ok_or_else(|| format!("unknown model '{name}' (simplified, single or double)"))
+        .ok_or_else(|| {
+            format!("option --model: unknown model '{name}' (simplified, single or double)")
+        })
 }
 
 fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), String> {
@@ -382,11 +458,7 @@ fn regulate(
 fn load(path: Option<&std::path::Path>) -> Result<ActionParams, String> {
     match path {
         None => Ok(ActionParams::reference()),
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| format!("cannot read {}: {e}", p.display()))?;
-            ActionParams::from_toml_str(&text).map_err(|e| format!("{}: {e}", p.display()))
-        }
+        Some(p) => ActionParams::load(p).map_err(|e| e.to_string()),
     }
 }
 
@@ -462,7 +534,9 @@ fn demo(params: &ActionParams) -> Result<(), String> {
 /// Writes a pressed and a struck touch of about the same loudness as run directories in
 /// the temporary folder, and their report side by side.
 fn demo_report(params: &ActionParams) -> Result<(), String> {
-    use piano_action::scenario::{InputSpec, Scenario, TouchStyleName, write_run_dir};
+    use piano_action::scenario::{
+        InputSpec, Scenario, TouchStyleName, prepare_run_dir, write_run_dir,
+    };
     let root = std::env::temp_dir().join("piano-demo");
     let touch = |style, peak_force_n, finger_speed_m_s| InputSpec::Touch {
         style,
@@ -491,11 +565,13 @@ fn demo_report(params: &ActionParams) -> Result<(), String> {
         };
         let run = scenario.run(params).map_err(|e| e.to_string())?;
         let dir = root.join(name);
+        // The demo's own folder in the temporary directory: replace the last demo's run.
+        prepare_run_dir(&dir, true).map_err(|e| e.to_string())?;
         write_run_dir(&dir, &scenario, params, &run).map_err(|e| e.to_string())?;
         dirs.push(dir);
     }
     println!("\nA pressed and a struck touch of about the same loudness, in slow motion:");
-    write_report(&dirs, &root.join("report.html"))
+    write_report(&dirs, &root.join("report.html"), true)
 }
 
 fn main() -> ExitCode {
@@ -511,16 +587,18 @@ fn main() -> ExitCode {
                 scenario,
                 out,
                 report,
-            } => simulate_scenario(&params, &scenario, &out, report),
+                force,
+            } => simulate_scenario(&params, &scenario, &out, report, force),
             Command::Plot {
                 run,
                 format,
                 out,
                 font,
-            } => plot(&run, &format, out, font.as_deref()),
-            Command::Report { runs, out } => {
+                force,
+            } => plot(&run, &format, out, font.as_deref(), force),
+            Command::Report { runs, out, force } => {
                 let out = out.unwrap_or_else(|| runs[0].join("report.html"));
-                write_report(&runs, &out)
+                write_report(&runs, &out, force)
             }
             Command::Sweep(args) => sweep(&params, args),
             Command::Params => {

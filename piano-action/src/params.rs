@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{PianoError, Result};
+use crate::error::{InputKind, PianoError, Result};
 
 /// The default parameter file (the reference grand action), as text.
 pub const DEFAULT_PARAMS_TOML: &str = include_str!("default_params.toml");
@@ -297,26 +297,24 @@ impl ActionParams {
     /// Parses a parameter file; an error names the field (as a path such as
     /// `hammer.mass_g`) and where it is.
     pub fn from_toml_str(text: &str) -> Result<Self> {
-        let de = toml::Deserializer::parse(text).map_err(|e| PianoError::Params {
-            field: String::new(),
-            message: e.to_string(),
-        })?;
-        let params: ActionParams =
-            serde_path_to_error::deserialize(de).map_err(|e| PianoError::Params {
-                field: e.path().to_string(),
-                message: e.inner().to_string(),
-            })?;
-        params.validate()?;
+        let params: ActionParams = crate::toml_lines::from_toml(text, InputKind::Parameters)?;
+        params.validate().map_err(|e| e.locate_in_toml(text))?;
         Ok(params)
+    }
+
+    /// Reads and parses the parameter file at `path`; errors name the file, the line and
+    /// the field.
+    pub fn load(path: &std::path::Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| PianoError::file(path, format!("cannot read the parameter file: {e}")))?;
+        Self::from_toml_str(&text).map_err(|e| e.in_file(path))
     }
 
     /// Checks every number is finite and every mass, inertia, radius and stiffness is
     /// positive, naming the first bad field.
     pub fn validate(&self) -> Result<()> {
-        let table = toml::Table::try_from(self).map_err(|e| PianoError::Params {
-            field: String::new(),
-            message: e.to_string(),
-        })?;
+        let table = toml::Table::try_from(self)
+            .map_err(|e| PianoError::params(String::new(), e.to_string()))?;
         check_table("", &table)?;
         let positive = [
             ("key.mass_g", self.key.mass_g),
@@ -349,17 +347,17 @@ impl ActionParams {
             ),
         ];
         if self.numerics.event_samples == 0 {
-            return Err(PianoError::Params {
-                field: "numerics.event_samples".into(),
-                message: "must be at least 1".into(),
-            });
+            return Err(PianoError::params(
+                "numerics.event_samples",
+                "must be at least 1",
+            ));
         }
         for (field, v) in positive {
             if v <= 0.0 {
-                return Err(PianoError::Params {
-                    field: field.into(),
-                    message: format!("must be positive, got {v}"),
-                });
+                return Err(PianoError::params(
+                    field,
+                    format!("must be positive, got {v}"),
+                ));
             }
         }
         Ok(())
@@ -368,10 +366,7 @@ impl ActionParams {
     /// The parameters as TOML text (for `piano params`; the embedded default keeps its
     /// comments, this form does not).
     pub fn to_toml_string(&self) -> Result<String> {
-        toml::to_string_pretty(self).map_err(|e| PianoError::Params {
-            field: String::new(),
-            message: e.to_string(),
-        })
+        toml::to_string_pretty(self).map_err(|e| PianoError::params(String::new(), e.to_string()))
     }
 }
 
@@ -390,10 +385,9 @@ fn check_table(prefix: &str, table: &toml::Table) -> Result<()> {
 
 fn check_value(path: &str, v: &toml::Value) -> Result<()> {
     match v {
-        toml::Value::Float(x) if !x.is_finite() => Err(PianoError::Params {
-            field: path.into(),
-            message: format!("must be finite, got {x}"),
-        }),
+        toml::Value::Float(x) if !x.is_finite() => {
+            Err(PianoError::params(path, format!("must be finite, got {x}")))
+        }
         toml::Value::Table(t) => check_table(path, t),
         toml::Value::Array(a) => {
             for (i, x) in a.iter().enumerate() {

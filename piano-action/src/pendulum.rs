@@ -29,18 +29,24 @@ pub struct Swing {
     pub inertia_pin_kg_m2: f64,
 }
 
+/// Checks a release angle: non-zero and within ±170° of hanging.
+pub fn check_release_angle(release_angle_deg: f64) -> Result<()> {
+    if release_angle_deg.is_finite() && release_angle_deg.abs() < 170.0 && release_angle_deg != 0.0
+    {
+        Ok(())
+    } else {
+        Err(PianoError::scenario(
+            "input.release_angle_deg",
+            format!("must be non-zero and within ±170°, got {release_angle_deg}"),
+        ))
+    }
+}
+
 /// Releases the hammer at `release_angle_deg` from its hanging position and lets it swing
 /// for `duration_s`; the turning points are located as events.
 pub fn swing(params: &ActionParams, release_angle_deg: f64, duration_s: f64) -> Result<Swing> {
-    if !(release_angle_deg.is_finite()
-        && release_angle_deg.abs() < 170.0
-        && release_angle_deg != 0.0)
-    {
-        return Err(PianoError::Params {
-            field: "input.release_angle_deg".into(),
-            message: format!("must be non-zero and within ±170°, got {release_angle_deg}"),
-        });
-    }
+    check_release_angle(release_angle_deg)?;
+    crate::simulate::check_duration(duration_s, 1e-3)?;
     let h = &params.hammer;
     let com = [h.com_body_mm[0] * 1e-3, h.com_body_mm[1] * 1e-3];
     let d = (com[0] * com[0] + com[1] * com[1]).sqrt();

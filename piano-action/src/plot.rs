@@ -26,10 +26,10 @@ impl Format {
         match name {
             "svg" => Ok(Format::Svg),
             "png" => Ok(Format::Png),
-            other => Err(PianoError::Params {
-                field: "--format".into(),
-                message: format!("unknown format '{other}' (svg or png)"),
-            }),
+            other => Err(PianoError::option(
+                "--format",
+                format!("unknown format '{other}' (svg or png)"),
+            )),
         }
     }
 }
@@ -67,10 +67,9 @@ fn register_font(font: Option<&Path>) -> Result<()> {
         plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
             .map_err(|_| format!("{} is not a TrueType or OpenType font", path.display()))
     });
-    outcome.clone().map_err(|message| PianoError::Params {
-        field: "--font".into(),
-        message,
-    })
+    outcome
+        .clone()
+        .map_err(|message| PianoError::option("--font", message))
 }
 
 /// Points of a line: time (ms) and value.
@@ -261,10 +260,7 @@ fn draw<DB: DrawingBackend>(
 pub fn plot_run(dir: &Path, format: Format, out: &Path, font: Option<&Path>) -> Result<()> {
     register_font(font)?;
     let run = crate::report::run_data(dir)?;
-    let failed = |e: String| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot draw {}: {e}", out.display()),
-    };
+    let failed = |e: String| PianoError::file(out, format!("cannot draw: {e}"));
     match format {
         Format::Svg => draw(
             &SVGBackend::new(out, (1600, 1200)).into_drawing_area(),

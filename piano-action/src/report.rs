@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 
 use crate::action::ModelKind;
-use crate::error::{PianoError, Result};
+use crate::error::{InputKind, PianoError, Result};
 use crate::params::ActionParams;
 use crate::scenario::{InputSpec, Scenario};
 use crate::simulate::{Prepared, key_depth_mm, prepare};
@@ -23,11 +23,9 @@ const STYLE: &str = include_str!("report/report.css");
 pub const GENERATOR: &str = "piano report";
 const SCRIPT: &str = include_str!("report/report.js");
 
+/// A broken run directory: the error names it.
 fn bad(dir: &Path, message: String) -> PianoError {
-    PianoError::Params {
-        field: String::new(),
-        message: format!("{}: {message}", dir.display()),
-    }
+    PianoError::input(InputKind::RunDir, "", message).in_file(dir)
 }
 
 fn read(dir: &Path, name: &str) -> Result<String> {
@@ -298,71 +296,24 @@ pub fn run_data(dir: &Path) -> Result<Value> {
     }))
 }
 
-/// The measured data of a run, if its directory has `measured.csv`: a `time_s` column and
-/// any of the plotted series by their ids (`hammer_angle_deg`, `hammer_speed_m_s`,
-/// `key_depth_mm`, ...), overlaid on the plots as points. Empty cells are gaps.
+/// The measured data of a run, if its directory has `measured.csv` (see
+/// [`crate::measured`]), as `{id: {t: [...], v: [...]}}`.
 fn read_measured(dir: &Path, series: &[(&str, &str, Vec<f64>)]) -> Result<Value> {
     let path = dir.join("measured.csv");
     if !path.exists() {
         return Ok(Value::Null);
     }
-    let text = read(dir, "measured.csv")?;
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-    let header: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| bad(dir, "measured.csv is empty".into()))?
-        .split(',')
-        .map(str::trim)
-        .collect();
-    if header.first() != Some(&"time_s") {
-        return Err(bad(
-            dir,
-            "measured.csv: the first column must be time_s".into(),
-        ));
-    }
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| PianoError::file(&path, format!("cannot read: {e}")))?;
     let known: Vec<&str> = series.iter().map(|s| s.0).collect();
-    for h in &header[1..] {
-        if !known.contains(h) {
-            return Err(bad(
-                dir,
-                format!(
-                    "measured.csv: unknown column '{h}' (known: {})",
-                    known.join(", ")
-                ),
-            ));
-        }
-    }
-    let mut columns: Vec<(Vec<f64>, Vec<f64>)> = vec![Default::default(); header.len() - 1];
-    for (i, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let number = |c: &str| -> Result<Option<f64>> {
-            if c.is_empty() {
-                return Ok(None);
-            }
-            c.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .map(Some)
-                .ok_or_else(|| {
-                    bad(
-                        dir,
-                        format!("measured.csv line {}: '{c}' is not a number", i + 2),
-                    )
-                })
-        };
-        let t = number(cells.first().copied().unwrap_or(""))?
-            .ok_or_else(|| bad(dir, format!("measured.csv line {}: no time", i + 2)))?;
-        for (k, col) in columns.iter_mut().enumerate() {
-            if let Some(v) = number(cells.get(k + 1).copied().unwrap_or(""))? {
-                col.0.push(r(t, 6));
-                col.1.push(r(v, 4));
-            }
-        }
-    }
-    Ok(header[1..]
-        .iter()
-        .zip(columns)
-        .map(|(h, (t, v))| (h.to_string(), json!({"t": t, "v": v})))
+    let measured = crate::measured::parse_measured(&text, &path, &known)?;
+    Ok(measured
+        .into_iter()
+        .map(|s| {
+            let t: Vec<f64> = s.t.iter().map(|&t| r(t, 6)).collect();
+            let v: Vec<f64> = s.v.iter().map(|&v| r(v, 4)).collect();
+            (s.id, json!({"t": t, "v": v}))
+        })
         .collect::<serde_json::Map<String, Value>>()
         .into())
 }
@@ -383,10 +334,10 @@ fn escape_html(s: &str) -> String {
 /// The report page of the runs in `dirs` (at least one), as one self-contained HTML string.
 pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
     if dirs.is_empty() {
-        return Err(PianoError::Params {
-            field: "RUN_DIR".into(),
-            message: "give at least one run directory".into(),
-        });
+        return Err(PianoError::option(
+            "RUN_DIR",
+            "give at least one run directory",
+        ));
     }
     let runs: Vec<Value> = dirs.iter().map(|d| run_data(d)).collect::<Result<_>>()?;
     let title = runs
@@ -426,28 +377,29 @@ pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
     Ok(html)
 }
 
-/// Writes the report of `dirs` to `out`. An existing `out` is replaced only if it is itself
-/// a report (its `generator` is [`GENERATOR`]); anything else is left alone, with an error.
-pub fn write_report(dirs: &[PathBuf], out: &Path) -> Result<()> {
+/// Writes the report of `dirs` to `out`. An existing `out` is refused, unless `replace`
+/// is set and it is itself a report (its `generator` is [`GENERATOR`]): anything else is
+/// left alone, with an error.
+pub fn write_report(dirs: &[PathBuf], out: &Path, replace: bool) -> Result<()> {
     if out.exists() {
         let ours = std::fs::read_to_string(out)
             .map(|t| t.contains(&format!(r#"<meta name="generator" content="{GENERATOR}">"#)))
             .unwrap_or(false);
         if !ours {
-            return Err(PianoError::Params {
-                field: "--out".into(),
-                message: format!(
-                    "{} exists and is not a piano report; choose another file",
-                    out.display()
-                ),
-            });
+            return Err(PianoError::file(
+                out,
+                "exists and is not a piano report; choose another --out",
+            ));
+        }
+        if !replace {
+            return Err(PianoError::file(
+                out,
+                "exists; choose another --out, or pass --force to replace it",
+            ));
         }
     }
     let html = report_html(dirs)?;
-    std::fs::write(out, html).map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot write {}: {e}", out.display()),
-    })
+    std::fs::write(out, html).map_err(|e| PianoError::file(out, format!("cannot write: {e}")))
 }
 
 #[cfg(test)]

@@ -7,9 +7,10 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::action::ModelKind;
-use crate::error::{PianoError, Result};
+use crate::error::{InputKind, PianoError, Result};
 use crate::params::ActionParams;
-use crate::simulate::{Finger, Input, Prepared, Run, TouchStyle, simulate};
+use crate::simulate::{Finger, Input, Prepared, Run, TouchStyle, simulate_observed};
+use crate::toml_lines::from_toml;
 
 /// The input of a scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -102,12 +103,11 @@ impl InputSpec {
             } => force_input(*force_n, *ramp_s, *release_s, points.as_deref())?,
             &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
             InputSpec::Pendulum { .. } => {
-                return Err(PianoError::Params {
-                    field: "input.kind".into(),
-                    message: "a pendulum scenario has no keystroke: run it with `swing` and \
-                              `write_pendulum_dir`"
-                        .into(),
-                });
+                return Err(PianoError::scenario(
+                    "input.kind",
+                    "a pendulum scenario has no keystroke: run it with `swing` and \
+                              `write_pendulum_dir`",
+                ));
             }
             InputSpec::Motion { points, csv } => match (points, csv) {
                 // Both: the points were read from the csv by `load`.
@@ -115,19 +115,19 @@ impl InputSpec {
                     points: points.iter().map(|p| (p[0], p[1])).collect(),
                 },
                 (None, Some(file)) => {
-                    return Err(PianoError::Params {
-                        field: "input.csv".into(),
-                        message: format!(
+                    return Err(PianoError::scenario(
+                        "input.csv",
+                        format!(
                             "'{file}' is read by Scenario::load, which knows where the \
                              scenario file is"
                         ),
-                    });
+                    ));
                 }
                 _ => {
-                    return Err(PianoError::Params {
-                        field: "input.points".into(),
-                        message: "give either points or csv".into(),
-                    });
+                    return Err(PianoError::scenario(
+                        "input.points",
+                        "give either points or csv",
+                    ));
                 }
             },
             &InputSpec::Touch {
@@ -138,13 +138,17 @@ impl InputSpec {
                 rise_s,
                 arm_damping_n_s_m,
             } => {
-                let missing = |field: &str, style: &str| PianoError::Params {
-                    field: format!("input.{field}"),
-                    message: format!("a {style} touch needs {field}"),
+                let missing = |field: &str, style: &str| {
+                    PianoError::scenario(
+                        format!("input.{field}"),
+                        format!("a {style} touch needs {field}"),
+                    )
                 };
-                let misplaced = |field: &str, style: &str| PianoError::Params {
-                    field: format!("input.{field}"),
-                    message: format!("does not apply to a {style} touch"),
+                let misplaced = |field: &str, style: &str| {
+                    PianoError::scenario(
+                        format!("input.{field}"),
+                        format!("does not apply to a {style} touch"),
+                    )
                 };
                 let style = match style {
                     TouchStyleName::Pressed => {
@@ -188,10 +192,7 @@ fn force_input(
     release_s: Option<f64>,
     points: Option<&[[f64; 2]]>,
 ) -> Result<Input> {
-    let field = |name: &str, message: &str| PianoError::Params {
-        field: format!("input.{name}"),
-        message: message.into(),
-    };
+    let field = |name: &str, message: &str| PianoError::scenario(format!("input.{name}"), message);
     if let Some(points) = points {
         for (name, given) in [
             ("force_n", force_n.is_some()),
@@ -229,11 +230,21 @@ fn force_input(
 /// Reads `[time, value]` rows from CSV text (comma, semicolon, tab or space separated; a
 /// first line that is not numbers is a header); errors name the file and the line.
 pub fn read_points_csv(text: &str, file: &str) -> Result<Vec<[f64; 2]>> {
-    let bad = |line: usize, message: String| PianoError::Params {
-        field: "input.csv".into(),
-        message: format!("{file} line {line}: {message}"),
+    read_points_csv_lines(text, Path::new(file)).map(|(points, _)| points)
+}
+
+/// Reads `[time, value]` rows like [`read_points_csv`], with the line of each row. Times
+/// must be finite, from 0 on and increasing, values finite; a row with more or fewer than
+/// two cells is refused.
+pub fn read_points_csv_lines(text: &str, file: &Path) -> Result<(Vec<[f64; 2]>, Vec<usize>)> {
+    let bad = |line: usize, message: String| {
+        PianoError::input(InputKind::PointsCsv, "", message)
+            .in_file(file)
+            .at_line((line > 0).then_some(line))
     };
-    let mut points = Vec::new();
+    let mut points: Vec<[f64; 2]> = Vec::new();
+    let mut lines = Vec::new();
+    let mut first = true;
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -244,13 +255,46 @@ pub fn read_points_csv(text: &str, file: &str) -> Result<Vec<[f64; 2]>> {
             .filter(|c| !c.is_empty())
             .collect();
         let numbers: Vec<Option<f64>> = cells.iter().map(|c| c.parse().ok()).collect();
+        let header = std::mem::take(&mut first) && numbers.iter().any(Option::is_none);
         match numbers.as_slice() {
-            [Some(t), Some(v)] => points.push([*t, *v]),
-            _ if points.is_empty() && numbers.iter().any(Option::is_none) && i == 0 => {}
+            _ if header => {}
+            [Some(t), Some(v)] => {
+                let (t, v) = (*t, *v);
+                if !(t.is_finite() && v.is_finite()) {
+                    return Err(bad(i + 1, format!("not finite: '{line}'")));
+                }
+                if t < 0.0 {
+                    return Err(bad(
+                        i + 1,
+                        format!("time {t} s is negative (times count from the run's start)"),
+                    ));
+                }
+                if let Some(prev) = points.last()
+                    && t <= prev[0]
+                {
+                    return Err(bad(
+                        i + 1,
+                        format!("times must increase: {t} s comes after {} s", prev[0]),
+                    ));
+                }
+                points.push([t, v]);
+                lines.push(i + 1);
+            }
+            [first, _] => {
+                let cell = if first.is_none() { cells[0] } else { cells[1] };
+                return Err(bad(
+                    i + 1,
+                    format!("'{cell}' is not a number (expected time, value): '{line}'"),
+                ));
+            }
             _ => {
                 return Err(bad(
                     i + 1,
-                    format!("expected two numbers (time, value), got '{line}'"),
+                    format!(
+                        "expected two numbers (time, value), got {} cell{}: '{line}'",
+                        cells.len(),
+                        if cells.len() == 1 { "" } else { "s" }
+                    ),
                 ));
             }
         }
@@ -258,7 +302,7 @@ pub fn read_points_csv(text: &str, file: &str) -> Result<Vec<[f64; 2]>> {
     if points.is_empty() {
         return Err(bad(0, "no data rows".into()));
     }
-    Ok(points)
+    Ok((points, lines))
 }
 
 /// A scenario file.
@@ -281,51 +325,79 @@ fn default_output_step() -> f64 {
 }
 
 impl Scenario {
-    /// Parses a scenario; errors name the field.
+    /// Parses a scenario and checks its values; errors name the field and its line.
     pub fn from_toml_str(text: &str) -> Result<Self> {
-        let de = toml::Deserializer::parse(text).map_err(|e| PianoError::Params {
-            field: String::new(),
-            message: e.to_string(),
-        })?;
-        serde_path_to_error::deserialize(de).map_err(|e| PianoError::Params {
-            field: e.path().to_string(),
-            message: e.inner().to_string(),
-        })
+        let scenario: Scenario = from_toml(text, InputKind::Scenario)?;
+        scenario.check().map_err(|e| e.locate_in_toml(text))?;
+        Ok(scenario)
+    }
+
+    /// Checks what can be checked before running: the model, the duration and output step,
+    /// and the input's values (a motion's `csv` is checked when [`Scenario::load`] reads it).
+    pub fn check(&self) -> Result<()> {
+        if let InputSpec::Pendulum { release_angle_deg } = self.input {
+            crate::pendulum::check_release_angle(release_angle_deg)?;
+        } else {
+            self.model_kind()?;
+        }
+        crate::simulate::check_duration(self.duration_s, self.output_step_s)?;
+        match &self.input {
+            InputSpec::Pendulum { .. } => Ok(()),
+            InputSpec::Motion {
+                points: None,
+                csv: Some(_),
+            } => Ok(()),
+            InputSpec::Motion {
+                points: Some(_),
+                csv: Some(_),
+            } => Err(PianoError::scenario(
+                "input.csv",
+                "give either points or csv, not both",
+            )),
+            spec => spec.to_input()?.validate(),
+        }
     }
 
     /// Reads and parses the scenario file at `path`, and reads a motion's `csv` (relative to
-    /// the scenario's folder) into its points. Errors name the file and the field.
+    /// the scenario's folder) into its points. Errors name the file, the line and the field.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| PianoError::Params {
-            field: String::new(),
-            message: format!("cannot read {}: {e}", path.display()),
-        })?;
-        let mut scenario = Self::from_toml_str(&text).map_err(|e| match e {
-            PianoError::Params { field, message } => PianoError::Params {
-                field,
-                message: format!("{message} (in {})", path.display()),
-            },
-            other => other,
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| PianoError::file(path, format!("cannot read the scenario: {e}")))?;
+        let mut scenario = Self::from_toml_str(&text).map_err(|e| e.in_file(path))?;
         if let InputSpec::Motion {
             points,
             csv: Some(file),
         } = &mut scenario.input
         {
-            if points.is_some() {
-                return Err(PianoError::Params {
-                    field: "input.csv".into(),
-                    message: "give either points or csv, not both".into(),
-                });
-            }
             let full = path.parent().unwrap_or(Path::new(".")).join(&*file);
-            let text = std::fs::read_to_string(&full).map_err(|e| PianoError::Params {
-                field: "input.csv".into(),
-                message: format!("cannot read {}: {e}", full.display()),
+            let text = std::fs::read_to_string(&full).map_err(|e| {
+                PianoError::scenario(
+                    "input.csv",
+                    format!("cannot read the key motion {}: {e}", full.display()),
+                )
+                .in_file(path)
             })?;
-            *points = Some(read_points_csv(&text, &full.display().to_string())?);
+            let (rows, lines) = read_points_csv_lines(&text, &full)?;
+            *points = Some(rows);
             // The points are now in the scenario (and its run.json); the file name stays as
-            // a record of where they came from.
+            // a record of where they came from. A bad value is shown at its CSV line.
+            scenario.input.to_input()?.validate().map_err(|e| {
+                let row = e
+                    .field()
+                    .strip_prefix("input.points[")
+                    .and_then(|r| r.split(']').next())
+                    .and_then(|r| r.parse::<usize>().ok());
+                match (row, e) {
+                    (Some(row), PianoError::Input(mut bad)) => {
+                        bad.kind = InputKind::PointsCsv;
+                        bad.file = Some(full.clone());
+                        bad.line = lines.get(row).copied();
+                        bad.field = String::new();
+                        PianoError::Input(bad)
+                    }
+                    (_, e) => e.in_file(path),
+                }
+            })?;
         }
         Ok(scenario)
     }
@@ -335,51 +407,126 @@ impl Scenario {
         ModelKind::ALL
             .into_iter()
             .find(|k| k.name() == self.model)
-            .ok_or_else(|| PianoError::Params {
-                field: "model".into(),
-                message: format!(
-                    "unknown model '{}' (simplified, single or double)",
-                    self.model
-                ),
+            .ok_or_else(|| {
+                PianoError::scenario(
+                    "model",
+                    format!(
+                        "unknown model '{}' (simplified, single or double)",
+                        self.model
+                    ),
+                )
             })
     }
 
     /// Runs the scenario.
     pub fn run(&self, params: &ActionParams) -> Result<Run> {
+        self.run_observed(params, &mut |_| {})
+    }
+
+    /// Runs the scenario, calling `progress` with the simulated time after every step.
+    pub fn run_observed(
+        &self,
+        params: &ActionParams,
+        progress: &mut dyn FnMut(f64),
+    ) -> Result<Run> {
         let input = self.input.to_input()?;
-        simulate(
+        simulate_observed(
             params,
             self.model_kind()?,
             &input,
             self.duration_s,
             self.output_step_s,
+            progress,
         )
     }
 }
 
 /// Writes `text` to `dir/name`; the error names the file.
 fn write_file(dir: &Path, name: &str, text: &str) -> Result<()> {
-    std::fs::write(dir.join(name), text).map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot write {}: {e}", dir.join(name).display()),
-    })
+    let path = dir.join(name);
+    std::fs::write(&path, text).map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))
 }
 
 /// Writes `value` as pretty JSON to `dir/name`.
 fn write_json(dir: &Path, name: &str, value: &serde_json::Value) -> Result<()> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot encode {name}: {e}"),
-    })?;
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| PianoError::file(&dir.join(name), format!("cannot encode as JSON: {e}")))?;
     write_file(dir, name, &text)
 }
 
-/// Creates the run directory and writes `run.json` (scenario, parameters, version).
+/// Whether `name` is a file that `piano` writes into a run directory (by `simulate`,
+/// `report` or `plot`).
+pub fn is_run_output(name: &str) -> bool {
+    matches!(
+        name,
+        "run.json"
+            | "trajectory.csv"
+            | "contacts.csv"
+            | "events.json"
+            | "summary.json"
+            | "report.html"
+            | "figure.svg"
+            | "figure.png"
+    ) || (name.starts_with("drawing_") && name.ends_with(".svg"))
+}
+
+/// The files of an earlier run in `dir` (empty when `dir` does not exist).
+fn run_outputs_in(dir: &Path) -> Result<Vec<std::path::PathBuf>> {
+    if !dir.exists() {
+        return Ok(Vec::new());
+    }
+    if !dir.is_dir() {
+        return Err(PianoError::file(
+            dir,
+            "is a file, not a folder: choose another --out",
+        ));
+    }
+    let entries = std::fs::read_dir(dir)
+        .map_err(|e| PianoError::file(dir, format!("cannot list the folder: {e}")))?;
+    let mut found = Vec::new();
+    for entry in entries.flatten() {
+        if entry.file_name().to_str().is_some_and(is_run_output) {
+            found.push(entry.path());
+        }
+    }
+    found.sort();
+    Ok(found)
+}
+
+/// Makes `dir` ready for a new run: created if missing; a folder that holds files of an
+/// earlier run is refused, unless `replace` is set, in which case those files (and only
+/// those: `measured.csv` and anything else of yours stays) are removed first, so old and
+/// new files are never mixed.
+pub fn prepare_run_dir(dir: &Path, replace: bool) -> Result<()> {
+    let old = run_outputs_in(dir)?;
+    if !old.is_empty() {
+        if !replace {
+            let names: Vec<String> = old
+                .iter()
+                .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .collect();
+            return Err(PianoError::file(
+                dir,
+                format!(
+                    "holds an earlier run ({}); choose another --out, or pass --force to \
+                     replace it",
+                    names.join(", ")
+                ),
+            ));
+        }
+        for path in old {
+            std::fs::remove_file(&path)
+                .map_err(|e| PianoError::file(&path, format!("cannot remove: {e}")))?;
+        }
+    }
+    std::fs::create_dir_all(dir)
+        .map_err(|e| PianoError::file(dir, format!("cannot create the folder: {e}")))
+}
+
+/// Creates the run directory and writes `run.json` (scenario, parameters, version); a
+/// folder holding an earlier run is refused (see [`prepare_run_dir`]).
 fn start_run_dir(dir: &Path, scenario: &Scenario, params: &ActionParams) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| PianoError::Params {
-        field: String::new(),
-        message: format!("cannot create {}: {e}", dir.display()),
-    })?;
+    prepare_run_dir(dir, false)?;
     let run_json = serde_json::json!({
         "scenario": serde_json::to_value(scenario).unwrap_or_default(),
         "params": serde_json::to_value(params).unwrap_or_default(),

@@ -110,44 +110,44 @@ impl Default for Finger {
 }
 
 impl Input {
-    fn validate(&self) -> Result<()> {
+    /// Checks the input's values (forces, speeds, masses, tables), naming the bad field.
+    pub fn validate(&self) -> Result<()> {
         match *self {
             Input::Force { force_n, release_s } => {
                 if !(force_n.is_finite() && force_n >= 0.0) {
-                    return Err(PianoError::Params {
-                        field: "input.force_n".into(),
-                        message: format!("must be a non-negative force, got {force_n}"),
-                    });
+                    return Err(PianoError::scenario(
+                        "input.force_n",
+                        format!("must be a non-negative force, got {force_n}"),
+                    ));
                 }
                 if let Some(t) = release_s
                     && !(t.is_finite() && t > 0.0)
                 {
-                    return Err(PianoError::Params {
-                        field: "input.release_s".into(),
-                        message: format!("must be positive, got {t}"),
-                    });
+                    return Err(PianoError::scenario(
+                        "input.release_s",
+                        format!("must be positive, got {t}"),
+                    ));
                 }
                 Ok(())
             }
             Input::MassDrop { mass_kg, height_m } => {
                 if !(mass_kg.is_finite() && mass_kg > 0.0 && mass_kg <= 20.0) {
-                    return Err(PianoError::Params {
-                        field: "input.mass_kg".into(),
-                        message: format!("must be a mass of up to 20 kg, got {mass_kg}"),
-                    });
+                    return Err(PianoError::scenario(
+                        "input.mass_kg",
+                        format!("must be a mass of up to 20 kg, got {mass_kg}"),
+                    ));
                 }
                 if !(height_m.is_finite() && (0.0..=0.5).contains(&height_m)) {
-                    return Err(PianoError::Params {
-                        field: "input.height_m".into(),
-                        message: format!("must be 0 to 0.5 m, got {height_m}"),
-                    });
+                    return Err(PianoError::scenario(
+                        "input.height_m",
+                        format!("must be 0 to 0.5 m, got {height_m}"),
+                    ));
                 }
                 Ok(())
             }
             Input::Touch { style, finger } => {
-                let bad = |field: &str, message: String| PianoError::Params {
-                    field: format!("input.{field}"),
-                    message,
+                let bad = |field: &str, message: String| {
+                    PianoError::scenario(format!("input.{field}"), message)
                 };
                 match style {
                     TouchStyle::Pressed { peak_force_n } => {
@@ -200,29 +200,46 @@ impl Input {
 }
 
 /// Checks a `(time, value)` table (field `input.points`): at least one point, finite,
-/// times increasing, each value accepted by `value_ok`.
+/// times from 0 on and increasing, each value accepted by `value_ok`. The error names the
+/// point (`input.points[3][1]`).
 fn check_table(
     points: &[(f64, f64)],
     what: &str,
     value_ok: impl Fn(f64) -> std::result::Result<(), String>,
 ) -> Result<()> {
-    let bad = |message: String| PianoError::Params {
-        field: "input.points".into(),
-        message,
-    };
+    let bad = |field: String, message: String| PianoError::scenario(field, message);
     if points.is_empty() {
-        return Err(bad(format!("needs at least one {what} point")));
+        return Err(bad(
+            "input.points".into(),
+            format!("needs at least one {what} point"),
+        ));
     }
     for (i, &(t, v)) in points.iter().enumerate() {
-        if !(t.is_finite() && v.is_finite()) {
-            return Err(bad(format!("point {i} is not finite: [{t}, {v}]")));
+        let (time, value) = (
+            format!("input.points[{i}][0]"),
+            format!("input.points[{i}][1]"),
+        );
+        if !t.is_finite() {
+            return Err(bad(time, format!("time is not finite: {t}")));
         }
-        value_ok(v).map_err(|m| bad(format!("point {i}: {m}")))?;
+        if !v.is_finite() {
+            return Err(bad(value, format!("value is not finite: {v}")));
+        }
+        if t < 0.0 {
+            return Err(bad(
+                time,
+                format!("time {t} s is negative (times count from the run's start)"),
+            ));
+        }
+        value_ok(v).map_err(|m| bad(value, m))?;
         if i > 0 && t <= points[i - 1].0 {
-            return Err(bad(format!(
-                "point {i}: times must increase, got {t} after {}",
-                points[i - 1].0
-            )));
+            return Err(bad(
+                time,
+                format!(
+                    "times must increase: {t} s comes after {} s",
+                    points[i - 1].0
+                ),
+            ));
         }
     }
     Ok(())
@@ -527,6 +544,51 @@ pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<
     })
 }
 
+/// The longest simulated time a run accepts (s) [D]: a keystroke is over in well under a
+/// second, a repeated-note pattern in a few, the hammer swing test rings down in tens.
+pub const MAX_DURATION_S: f64 = 60.0;
+
+/// The most output points a run keeps [D]: a million rows of `trajectory.csv` is already
+/// a few hundred megabytes.
+pub const MAX_OUTPUT_POINTS: f64 = 1e6;
+
+/// Checks a run's `duration_s` and `output_step_s` before anything runs: positive, finite,
+/// at most [`MAX_DURATION_S`], and at most [`MAX_OUTPUT_POINTS`] output points.
+pub fn check_duration(duration_s: f64, output_step_s: f64) -> Result<()> {
+    if !(duration_s.is_finite() && duration_s > 0.0) {
+        return Err(PianoError::scenario(
+            "duration_s",
+            format!("must be a positive number of seconds, got {duration_s}"),
+        ));
+    }
+    if duration_s > MAX_DURATION_S {
+        return Err(PianoError::scenario(
+            "duration_s",
+            format!(
+                "{duration_s} s is longer than the {MAX_DURATION_S} s a run may last (a \
+                 keystroke is over in under a second); simulate less time"
+            ),
+        ));
+    }
+    if !(output_step_s.is_finite() && output_step_s > 0.0) {
+        return Err(PianoError::scenario(
+            "output_step_s",
+            format!("must be a positive number of seconds, got {output_step_s}"),
+        ));
+    }
+    let points = duration_s / output_step_s;
+    if points > MAX_OUTPUT_POINTS {
+        return Err(PianoError::scenario(
+            "output_step_s",
+            format!(
+                "{output_step_s} s over {duration_s} s gives {points:.3e} output points, more \
+                 than the {MAX_OUTPUT_POINTS:.0e} a run keeps; choose a longer output step"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Simulates `kind` driven by `input` for `duration_s`, with output every `output_step_s`.
 pub fn simulate(
     params: &ActionParams,
@@ -535,12 +597,20 @@ pub fn simulate(
     duration_s: f64,
     output_step_s: f64,
 ) -> Result<Run> {
-    if !(duration_s.is_finite() && duration_s > 0.0) {
-        return Err(PianoError::Params {
-            field: "duration_s".into(),
-            message: format!("must be positive, got {duration_s}"),
-        });
-    }
+    simulate_observed(params, kind, input, duration_s, output_step_s, &mut |_| {})
+}
+
+/// Simulates like [`simulate()`], calling `progress` with the simulated time after every
+/// integration step (for a progress bar).
+pub fn simulate_observed(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    duration_s: f64,
+    output_step_s: f64,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run> {
+    check_duration(duration_s, output_step_s)?;
     let Prepared {
         action,
         x0,
@@ -548,7 +618,8 @@ pub fn simulate(
     } = prepare(params, kind, input)?;
     let model = action.system.model().clone();
     let nv = model.nv();
-    let solution = action.integrate(&x0, duration_s, 1e-3, Some(output_step_s))?;
+    let solution =
+        action.integrate_observed(&x0, duration_s, 1e-3, Some(output_step_s), progress)?;
     let mut key_drive_force_n = Vec::new();
     if matches!(input, Input::Motion { .. }) {
         let key = model.coordinate_id("key")?;

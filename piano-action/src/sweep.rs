@@ -64,19 +64,19 @@ impl SweepKind {
 /// `n` values from `from` to `to`, evenly spaced on a log scale (both must be positive) or
 /// a linear one.
 pub fn levels(from: f64, to: f64, n: usize, log: bool) -> Result<Vec<f64>> {
-    let bad = |message: String| PianoError::Params {
-        field: "sweep".into(),
-        message,
-    };
-    if !(from.is_finite() && to.is_finite()) || n == 0 {
-        return Err(bad(format!(
-            "needs finite bounds and at least one run, got {from}..{to}, {n} runs"
-        )));
+    if n == 0 {
+        return Err(PianoError::option("--runs", "needs at least one run"));
     }
-    if log && !(from > 0.0 && to > 0.0) {
-        return Err(bad(format!(
-            "a log sweep needs positive bounds, got {from}..{to}"
-        )));
+    for (flag, v) in [("--from", from), ("--to", to)] {
+        if !v.is_finite() {
+            return Err(PianoError::option(flag, format!("must be finite, got {v}")));
+        }
+        if log && v <= 0.0 {
+            return Err(PianoError::option(
+                flag,
+                format!("a log sweep needs positive levels, got {v} (or pass --linear)"),
+            ));
+        }
     }
     Ok((0..n)
         .map(|i| {

@@ -44,9 +44,11 @@ fn the_report_works_in_headless_chromium() {
     .unwrap();
     let params = ActionParams::reference();
     let result = scenario.run(&params).unwrap();
+    // The folder is kept between test runs: replace the last run and report.
+    piano_action::scenario::prepare_run_dir(&run, true).unwrap();
     write_run_dir(&run, &scenario, &params, &result).unwrap();
     let report = root.join("report.html");
-    write_report(std::slice::from_ref(&run), &report).unwrap();
+    write_report(std::slice::from_ref(&run), &report, true).unwrap();
     let strike = result.strikes[0].time_s;
     let shots = root.join("screenshots");
     let out = Command::new("node")

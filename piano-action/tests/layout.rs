@@ -1,7 +1,7 @@
 //! The reference parameters load, all three models assemble, and the layout at rest has
 //! the clearances of action_layout.md §8 (gaps measured through the contact geometry).
 
-use piano_action::{Action, ActionParams, ModelKind, PianoError};
+use piano_action::{Action, ActionParams, ModelKind};
 
 fn gaps_mm(action: &Action) -> Vec<(&'static str, f64)> {
     let x = action.layout_state().unwrap();
@@ -102,7 +102,7 @@ fn bad_parameter_files_name_the_field() {
         piano_action::params::DEFAULT_PARAMS_TOML.replace("mass_g = 11.74", "mass_g = \"heavy\"");
     let e = ActionParams::from_toml_str(&text).unwrap_err();
     assert!(
-        matches!(&e, PianoError::Params { field, .. } if field == "hammer.mass_g"),
+        e.field() == "hammer.mass_g",
         "{e}"
     );
     let text = piano_action::params::DEFAULT_PARAMS_TOML.replace("crown_radius_mm", "crown_radius");

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use piano_action::report::{report_html, write_report};
 use piano_action::scenario::{Scenario, write_run_dir};
-use piano_action::{ActionParams, PianoError};
+use piano_action::ActionParams;
 
 fn run_dir(name: &str, scenario: &str) -> PathBuf {
     let dir = std::env::temp_dir()
@@ -121,17 +121,19 @@ fn several_runs_share_one_page_and_files_are_kept_safe() {
         "model = \"single\"\nduration_s = 0.1\n[input]\nkind = \"force\"\nforce_n = 10.0\n",
     );
     let out = a.parent().unwrap().join("both.html");
-    write_report(&[a.clone(), b.clone()], &out).unwrap();
+    write_report(&[a.clone(), b.clone()], &out, false).unwrap();
     let html = std::fs::read_to_string(&out).unwrap();
     let data = embedded(&html);
     assert_eq!(data["runs"].as_array().unwrap().len(), 2);
     assert_eq!(data["runs"][1]["model"], "single");
     assert!(data["runs"][1]["carry"].get("repetition_lever").is_none());
-    // A report is replaced; any other file is not.
-    write_report(std::slice::from_ref(&a), &out).unwrap();
+    // A report is replaced only when asked; any other file never.
+    let e = write_report(std::slice::from_ref(&a), &out, false).unwrap_err();
+    assert!(e.to_string().contains("--force"), "{e}");
+    write_report(std::slice::from_ref(&a), &out, true).unwrap();
     let mine = a.parent().unwrap().join("notes.html");
     std::fs::write(&mine, "my notes").unwrap();
-    let e = write_report(std::slice::from_ref(&a), &mine).unwrap_err();
+    let e = write_report(std::slice::from_ref(&a), &mine, true).unwrap_err();
     assert!(e.to_string().contains("not a piano report"), "{e}");
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my notes");
 }
@@ -151,7 +153,7 @@ fn broken_run_directories_are_named() {
     assert!(e.to_string().contains("run.json"), "{e}");
     assert!(matches!(
         report_html(&[]),
-        Err(PianoError::Params { field, .. }) if field == "RUN_DIR"
+        Err(e) if e.field() == "RUN_DIR"
     ));
 }
 
@@ -183,10 +185,10 @@ fn measured_data_beside_a_run_are_embedded_for_overlay() {
     .unwrap();
     let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
     assert!(
-        e.to_string().contains("unknown column 'hammer_velocity'"),
+        e.to_string().contains("column `hammer_velocity`: not a plotted quantity"),
         "{e}"
     );
     std::fs::write(dir.join("measured.csv"), "time_s,key_depth_mm\n0.0,deep\n").unwrap();
     let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
-    assert!(e.to_string().contains("measured.csv line 2"), "{e}");
+    assert!(e.to_string().contains("measured.csv, line 2"), "{e}");
 }

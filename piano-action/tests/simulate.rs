@@ -1,6 +1,6 @@
 //! Keystrokes through `simulate`: piano events and strike metrics.
 
-use piano_action::{ActionParams, Input, ModelKind, PianoError, simulate};
+use piano_action::{ActionParams, Input, ModelKind, simulate};
 
 #[test]
 fn hammer_velocity_grows_with_key_force_and_events_come_in_order() {
@@ -59,7 +59,7 @@ fn bad_inputs_are_named() {
     )
     .unwrap_err();
     assert!(
-        matches!(&e, PianoError::Params { field, .. } if field == "input.force_n"),
+        e.field() == "input.force_n",
         "{e}"
     );
     let e = simulate(
@@ -161,9 +161,24 @@ fn a_key_motion_can_come_from_a_csv_file_beside_the_scenario() {
     std::fs::write(dir.join("key.csv"), "0.0,0.0\n0.03,ten\n").unwrap();
     let e = Scenario::load(&path).unwrap_err().to_string();
     assert!(
-        e.contains("input.csv") && e.contains("key.csv line 2"),
+        e.contains("key.csv, line 2") && e.contains("'ten' is not a number"),
         "{e}"
     );
+    // Rows with an extra cell, times out of order or negative, and depths out of range are
+    // refused at their CSV line.
+    for (rows, line, what) in [
+        ("0.0,0.0\n0.03,10.0,1\n", 2, "3 cells"),
+        ("time_s,depth_mm\n0.0,0.0\n0.03,10.0\n0.02,10.0\n", 4, "must increase"),
+        ("-0.01,0.0\n0.03,10.0\n", 1, "negative"),
+        ("0.0,0.0\n\n0.03,10.0\n0.05,35.0\n", 4, "outside -20..20 mm"),
+    ] {
+        std::fs::write(dir.join("key.csv"), rows).unwrap();
+        let e = Scenario::load(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("key.csv, line {line}:")) && e.contains(what),
+            "{rows}: {e}"
+        );
+    }
     std::fs::remove_file(dir.join("key.csv")).unwrap();
     let e = Scenario::load(&path).unwrap_err().to_string();
     assert!(e.contains("input.csv") && e.contains("key.csv"), "{e}");
