@@ -14,13 +14,14 @@ fn levels_are_spaced_as_asked_and_bad_bounds_are_named() {
     }
     assert_eq!(levels(1.0, 3.0, 3, false).unwrap(), vec![1.0, 2.0, 3.0]);
     assert_eq!(levels(2.0, 5.0, 1, true).unwrap(), vec![2.0]);
-    for (from, to, n, log) in [
-        (0.0, 1.0, 3, true),
-        (1.0, f64::NAN, 3, false),
-        (1.0, 2.0, 0, false),
+    // Each bad bound names its option.
+    for (from, to, n, log, option) in [
+        (0.0, 1.0, 3, true, "option --from"),
+        (1.0, f64::NAN, 3, false, "option --to"),
+        (1.0, 2.0, 0, false, "option --runs"),
     ] {
         let err = levels(from, to, n, log).unwrap_err();
-        assert!(err.to_string().contains("sweep"), "{err}");
+        assert!(err.to_string().starts_with(option), "{err}");
     }
 }
 
