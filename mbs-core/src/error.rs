@@ -95,6 +95,9 @@ pub enum CoreError {
     /// A model description could not be parsed.
     #[error("model description: {0}")]
     Parse(String),
+    /// A states file (the inspect tool's input) could not be read or holds a bad state.
+    #[error("states file: {0}")]
+    States(String),
     /// A name was looked up that the model does not have.
     #[error("unknown {what} '{name}'")]
     UnknownName {

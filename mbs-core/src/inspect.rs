@@ -57,10 +57,34 @@ pub struct ReportFile {
 
 impl StatesFile {
     /// Parses the JSON states file; errors name the field path.
+    /// An empty list of states is refused, and so is a value that is not finite.
     pub fn from_json_str(text: &str) -> Result<Self> {
         let de = &mut serde_json::Deserializer::from_str(text);
-        serde_path_to_error::deserialize(de)
-            .map_err(|e| CoreError::Parse(format!("field `{}`: {}", e.path(), e.inner())))
+        let file: StatesFile = serde_path_to_error::deserialize(de).map_err(|e| {
+            let inner = e.inner();
+            CoreError::States(format!(
+                "line {}, column {}, field `{}`: {}",
+                inner.line(),
+                inner.column(),
+                e.path(),
+                inner
+            ))
+        })?;
+        if file.states.is_empty() {
+            return Err(CoreError::States(
+                "field `states`: the list is empty; give at least one state".into(),
+            ));
+        }
+        for (k, s) in file.states.iter().enumerate() {
+            for (name, values) in [("q", &s.q), ("v", &s.v), ("a", &s.a), ("tau", &s.tau)] {
+                if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                    return Err(CoreError::States(format!(
+                        "field `states[{k}].{name}[{i}]`: {v} is not a finite number"
+                    )));
+                }
+            }
+        }
+        Ok(file)
     }
 }
 
@@ -70,10 +94,7 @@ pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
     let n = model.nv();
     let mut states = Vec::with_capacity(input.states.len());
     for (k, s) in input.states.iter().enumerate() {
-        let at = |e: CoreError| CoreError::InvalidParameter {
-            item: format!("states[{k}]"),
-            message: e.to_string(),
-        };
+        let at = |e: CoreError| CoreError::States(format!("field `states[{k}]`: {e}"));
         let m = crba(model, &mut data, &s.q).map_err(at)?;
         let mass_matrix = (0..n)
             .map(|i| (0..n).map(|j| m[(i, j)]).collect())
@@ -94,13 +115,34 @@ pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
             .map_err(at)?
             .as_slice()
             .to_vec();
-        states.push(StateReport {
+        let report = StateReport {
             mass_matrix,
             rnea_tau,
             nonlinear_effects: nle,
             gravity_torque: g,
             aba_qdd: qdd,
-        });
+        };
+        // A finite state can still overflow (v = 1e300 squares to infinity): say so rather
+        // than print `null`.
+        for (name, values) in [
+            ("rnea_tau", &report.rnea_tau),
+            ("nonlinear_effects", &report.nonlinear_effects),
+            ("gravity_torque", &report.gravity_torque),
+            ("aba_qdd", &report.aba_qdd),
+        ] {
+            if values.iter().any(|v| !v.is_finite()) {
+                return Err(CoreError::States(format!(
+                    "field `states[{k}]`: {name} is not finite (the state's values are too \
+                     large to evaluate)"
+                )));
+            }
+        }
+        if report.mass_matrix.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(CoreError::States(format!(
+                "field `states[{k}]`: the mass matrix is not finite"
+            )));
+        }
+        states.push(report);
     }
     Ok(ReportFile { states })
 }

@@ -175,14 +175,18 @@ impl Model {
             })
     }
 
-    /// Name of a body (`"ground"` for the ground).
-    pub fn body_name(&self, body: BodyId) -> &str {
-        &self.body_names[body.0]
+    /// Name of a body (`"ground"` for the ground); `None` for an id that is not one of this
+    /// model's bodies (an id taken from another model).
+    pub fn body_name(&self, body: BodyId) -> Option<&str> {
+        self.body_names.get(body.0).map(String::as_str)
     }
 
-    /// Parent of a moving body (`None` for the ground).
+    /// Parent of a moving body (`None` for the ground, and for an id that is not one of
+    /// this model's bodies).
     pub fn parent(&self, body: BodyId) -> Option<BodyId> {
-        (body.0 > 0).then(|| BodyId(self.bodies[body.0].parent))
+        (body.0 > 0)
+            .then(|| self.bodies.get(body.0).map(|b| BodyId(b.parent)))
+            .flatten()
     }
 
     /// Joint connecting a moving body to its parent (`None` for the ground).

@@ -396,7 +396,7 @@ proptest! {
         }
         // A moving link's body pose is its frame pose.
         for b in model.moving_bodies() {
-            let i: usize = model.body_name(b)[4..].parse().unwrap();
+            let i: usize = model.body_name(b).unwrap()[4..].parse().unwrap();
             let got = data.body_pose(b);
             let w = want[i];
             check_close("body pose", &[got.c, got.s, got.x, got.y], &[w.c, w.s, w.x, w.y], TOL)?;

@@ -1102,7 +1102,7 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
             let frame = if body == mbs_core::BodyId::GROUND {
                 None
             } else {
-                Some(model.body_name(body).to_string())
+                model.body_name(body).map(str::to_string)
             };
             let pose = rest_data.body_pose(body);
             let placed: Vec<serde_json::Value> = shapes

@@ -174,7 +174,10 @@ mod tests {
         let m = message("time_s,key_depth_mm\n0,inf\n");
         assert!(m.contains("not a finite number"), "{m}");
         let m = message("time_s,speed\n0,1\n");
-        assert!(m.contains("column `speed`") && m.contains("known: hammer"), "{m}");
+        assert!(
+            m.contains("column `speed`") && m.contains("known: hammer"),
+            "{m}"
+        );
         let m = message("time_s,key_depth_mm,key_depth_mm\n");
         assert!(m.contains("named twice"), "{m}");
         let m = message("t,key_depth_mm\n");

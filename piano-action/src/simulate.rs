@@ -271,9 +271,36 @@ pub struct BlendedLinear {
 }
 
 impl BlendedLinear {
-    /// Builds the motion through `(t, q)` points (times increasing, at least one), each
-    /// corner rounded over `2 τ` with `τ = min(max_blend_s, a quarter of each side)`.
-    pub fn new(points: &[(f64, f64)], max_blend_s: f64) -> Self {
+    /// Builds the motion through `(t, q)` points, each corner rounded over `2 τ` with
+    /// `τ = min(max_blend_s, a quarter of each side)`. Refused: no points, values that are
+    /// not finite, times that do not increase, a negative or non-finite blend.
+    pub fn new(points: &[(f64, f64)], max_blend_s: f64) -> Result<Self> {
+        if points.is_empty() {
+            return Err(PianoError::option(
+                "points",
+                "a motion needs at least one point",
+            ));
+        }
+        if !(max_blend_s.is_finite() && max_blend_s >= 0.0) {
+            return Err(PianoError::option(
+                "max_blend_s",
+                format!("must be a non-negative time, got {max_blend_s}"),
+            ));
+        }
+        for (i, p) in points.iter().enumerate() {
+            if !(p.0.is_finite() && p.1.is_finite()) {
+                return Err(PianoError::option(
+                    format!("points[{i}]"),
+                    format!("must be finite, got ({}, {})", p.0, p.1),
+                ));
+            }
+            if i > 0 && p.0 <= points[i - 1].0 {
+                return Err(PianoError::option(
+                    format!("points[{i}]"),
+                    format!("times must increase: {} after {}", p.0, points[i - 1].0),
+                ));
+            }
+        }
         let t: Vec<f64> = points.iter().map(|p| p.0).collect();
         let q: Vec<f64> = points.iter().map(|p| p.1).collect();
         let n = t.len();
@@ -292,7 +319,7 @@ impl BlendedLinear {
                 max_blend_s.min(0.25 * before).min(0.25 * after)
             })
             .collect();
-        BlendedLinear { t, q, tau }
+        Ok(BlendedLinear { t, q, tau })
     }
 
     /// Slope of segment `i` (between points `i` and `i + 1`); 0 outside the table.
@@ -407,7 +434,8 @@ fn key_start_time(
     rest_depth_mm: f64,
 ) -> Option<f64> {
     if let Input::Motion { points } = input {
-        let depth = BlendedLinear::new(points, 5e-3);
+        // The table was checked before the run.
+        let depth = BlendedLinear::new(points, 5e-3).ok()?;
         let (t0, t1) = (points[0].0 - 5e-3, points[points.len() - 1].0 + 5e-3);
         let n = ((t1 - t0) / 1e-5).ceil() as usize;
         return (0..=n)
@@ -533,7 +561,7 @@ pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<
                 .collect();
             action
                 .system
-                .prescribe("key", BlendedLinear::new(&table, 5e-3))?;
+                .prescribe("key", BlendedLinear::new(&table, 5e-3)?)?;
         }
     }
     let x0 = action.system.initial_state(0.0, &q0, &v0)?;

@@ -101,10 +101,7 @@ fn bad_parameter_files_name_the_field() {
     let text =
         piano_action::params::DEFAULT_PARAMS_TOML.replace("mass_g = 11.74", "mass_g = \"heavy\"");
     let e = ActionParams::from_toml_str(&text).unwrap_err();
-    assert!(
-        e.field() == "hammer.mass_g",
-        "{e}"
-    );
+    assert!(e.field() == "hammer.mass_g", "{e}");
     let text = piano_action::params::DEFAULT_PARAMS_TOML.replace("crown_radius_mm", "crown_radius");
     let e = ActionParams::from_toml_str(&text).unwrap_err();
     assert!(e.to_string().contains("crown_radius"), "{e}");

@@ -67,8 +67,5 @@ fn a_one_kilogram_mass_released_on_the_key_strikes_and_the_hammer_is_checked() {
         1e-3,
     )
     .unwrap_err();
-    assert!(
-        e.field() == "input.mass_kg",
-        "{e}"
-    );
+    assert!(e.field() == "input.mass_kg", "{e}");
 }

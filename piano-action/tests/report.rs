@@ -2,9 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
+use piano_action::ActionParams;
 use piano_action::report::{report_html, write_report};
 use piano_action::scenario::{Scenario, write_run_dir};
-use piano_action::ActionParams;
 
 fn run_dir(name: &str, scenario: &str) -> PathBuf {
     let dir = std::env::temp_dir()
@@ -185,7 +185,8 @@ fn measured_data_beside_a_run_are_embedded_for_overlay() {
     .unwrap();
     let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
     assert!(
-        e.to_string().contains("column `hammer_velocity`: not a plotted quantity"),
+        e.to_string()
+            .contains("column `hammer_velocity`: not a plotted quantity"),
         "{e}"
     );
     std::fs::write(dir.join("measured.csv"), "time_s,key_depth_mm\n0.0,deep\n").unwrap();

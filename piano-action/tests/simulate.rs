@@ -58,10 +58,7 @@ fn bad_inputs_are_named() {
         1e-3,
     )
     .unwrap_err();
-    assert!(
-        e.field() == "input.force_n",
-        "{e}"
-    );
+    assert!(e.field() == "input.force_n", "{e}");
     let e = simulate(
         &params,
         ModelKind::Double,
@@ -168,7 +165,11 @@ fn a_key_motion_can_come_from_a_csv_file_beside_the_scenario() {
     // refused at their CSV line.
     for (rows, line, what) in [
         ("0.0,0.0\n0.03,10.0,1\n", 2, "3 cells"),
-        ("time_s,depth_mm\n0.0,0.0\n0.03,10.0\n0.02,10.0\n", 4, "must increase"),
+        (
+            "time_s,depth_mm\n0.0,0.0\n0.03,10.0\n0.02,10.0\n",
+            4,
+            "must increase",
+        ),
         ("-0.01,0.0\n0.03,10.0\n", 1, "negative"),
         ("0.0,0.0\n\n0.03,10.0\n0.05,35.0\n", 4, "outside -20..20 mm"),
     ] {
