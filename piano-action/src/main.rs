@@ -150,7 +150,9 @@ fn simulate_scenario(
     let scenario = Scenario::load(path).map_err(|e| e.to_string())?;
     // Refuse (or clear) an earlier run before spending time on this one.
     prepare_run_dir(out, force).map_err(|e| e.to_string())?;
-    if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
+    if let InputSpec::Pendulum(piano_action::scenario::PendulumSpec { release_angle_deg }) =
+        scenario.input
+    {
         let swing = piano_action::pendulum::swing(params, release_angle_deg, scenario.duration_s)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         write_pendulum_dir(out, &scenario, params, &swing).map_err(|e| e.to_string())?;
@@ -538,13 +540,15 @@ fn demo_report(params: &ActionParams) -> Result<(), String> {
         InputSpec, Scenario, TouchStyleName, prepare_run_dir, write_run_dir,
     };
     let root = std::env::temp_dir().join("piano-demo");
-    let touch = |style, peak_force_n, finger_speed_m_s| InputSpec::Touch {
-        style,
-        peak_force_n,
-        finger_speed_m_s,
-        finger_mass_g: None,
-        rise_s: None,
-        arm_damping_n_s_m: None,
+    let touch = |style, peak_force_n, finger_speed_m_s| {
+        InputSpec::Touch(piano_action::scenario::TouchSpec {
+            style,
+            peak_force_n,
+            finger_speed_m_s,
+            finger_mass_g: None,
+            rise_s: None,
+            arm_damping_n_s_m: None,
+        })
     };
     let mut dirs = Vec::new();
     for (name, input) in [

@@ -15,7 +15,9 @@ use serde_json::{Value, json};
 use crate::action::ModelKind;
 use crate::error::{InputKind, PianoError, Result};
 use crate::params::ActionParams;
-use crate::scenario::{InputSpec, Scenario};
+use crate::scenario::{
+    ForceSpec, InputSpec, MassDropSpec, MotionSpec, PendulumSpec, Scenario, TouchSpec,
+};
 use crate::simulate::{Prepared, key_depth_mm, prepare};
 
 const STYLE: &str = include_str!("report/report.css");
@@ -82,24 +84,26 @@ fn read_trajectory(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
 /// A short description of a scenario's input, for titles and legends.
 fn describe(input: &InputSpec) -> String {
     match input {
-        InputSpec::Force {
+        InputSpec::Force(ForceSpec {
             force_n: Some(f), ..
-        } => format!("force {f} N"),
-        InputSpec::Force { .. } => "force table".into(),
-        InputSpec::MassDrop { mass_kg, height_m } => {
+        }) => format!("force {f} N"),
+        InputSpec::Force(ForceSpec { .. }) => "force table".into(),
+        InputSpec::MassDrop(MassDropSpec { mass_kg, height_m }) => {
             format!("{mass_kg} kg dropped from {} mm", height_m * 1e3)
         }
-        InputSpec::Pendulum { release_angle_deg } => format!("pendulum {release_angle_deg}°"),
-        InputSpec::Motion { .. } => "key motion".into(),
-        InputSpec::Touch {
+        InputSpec::Pendulum(PendulumSpec { release_angle_deg }) => {
+            format!("pendulum {release_angle_deg}°")
+        }
+        InputSpec::Motion(MotionSpec { .. }) => "key motion".into(),
+        InputSpec::Touch(TouchSpec {
             peak_force_n: Some(f),
             ..
-        } => format!("pressed touch {f} N"),
-        InputSpec::Touch {
+        }) => format!("pressed touch {f} N"),
+        InputSpec::Touch(TouchSpec {
             finger_speed_m_s: Some(v),
             ..
-        } => format!("struck touch {v} m/s"),
-        InputSpec::Touch { .. } => "touch".into(),
+        }) => format!("struck touch {v} m/s"),
+        InputSpec::Touch(TouchSpec { .. }) => "touch".into(),
     }
 }
 
@@ -111,7 +115,7 @@ pub fn run_data(dir: &Path) -> Result<Value> {
     let params: ActionParams = serde_json::from_value(run["params"].clone())
         .map_err(|e| bad(dir, format!("run.json params: {e}")))?;
     params.validate()?;
-    if matches!(scenario.input, InputSpec::Pendulum { .. }) {
+    if matches!(scenario.input, InputSpec::Pendulum(PendulumSpec { .. })) {
         return Err(bad(
             dir,
             "a pendulum run has no keystroke to replay (its summary.json has the swing)".into(),

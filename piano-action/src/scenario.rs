@@ -14,71 +14,143 @@ use crate::toml_lines::from_toml;
 
 /// The input of a scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(tag = "kind", rename_all = "snake_case")]
 pub enum InputSpec {
-    /// A force on the key front: `force_n` (N) from t = 0, reached after `ramp_s` if given
-    /// (a linear ramp), released at `release_s` if given; or a table
-    /// `points = [[time_s, force_n], ...]`, piecewise linear.
-    Force {
-        /// Force (N).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        force_n: Option<f64>,
-        /// Rise time of a ramp (s).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        ramp_s: Option<f64>,
-        /// Release time (s).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        release_s: Option<f64>,
-        /// `[time_s, force_n]` points, instead of `force_n`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        points: Option<Vec<[f64; 2]>>,
-    },
-    /// A mass released on the key front from `height_m` (0: placed on it).
-    MassDrop {
-        /// Mass (kg).
-        mass_kg: f64,
-        /// Drop height (m).
-        height_m: f64,
-    },
-    /// The hammer alone on its flange released from `release_angle_deg` off hanging (the
-    /// pendulum or swing test); `model` is not used.
-    Pendulum {
-        /// Release angle from the hanging position (degrees).
-        release_angle_deg: f64,
-    },
-    /// A finger touch: `style = "pressed"` with `peak_force_n`, or `style = "struck"` with
-    /// `finger_speed_m_s`; the finger's `finger_mass_g`, `rise_s` and `arm_damping_n_s_m`
-    /// default to [`Finger::default`].
-    Touch {
-        /// `"pressed"` or `"struck"`.
-        style: TouchStyleName,
-        /// Peak force of a pressed touch (N).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        peak_force_n: Option<f64>,
-        /// Arrival speed of a struck finger (m/s).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        finger_speed_m_s: Option<f64>,
-        /// Effective finger mass (g).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        finger_mass_g: Option<f64>,
-        /// Rise time of a pressed touch's force (s).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        rise_s: Option<f64>,
-        /// Arm coupling of a struck touch (N·s/m).
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        arm_damping_n_s_m: Option<f64>,
-    },
-    /// Prescribed key-front depth below rest, `points = [[time_s, depth_mm], ...]`,
-    /// piecewise linear, or read from `csv = "FILE"` (two columns, time_s and depth_mm, an
-    /// optional header line; the path relative to the scenario file).
-    Motion {
-        /// `[time_s, depth_mm]` points.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        points: Option<Vec<[f64; 2]>>,
-        /// A CSV file of the points, instead of `points`.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        csv: Option<String>,
-    },
+    /// `kind = "force"`: a force on the key front.
+    Force(ForceSpec),
+    /// `kind = "mass_drop"`: a mass released on the key front.
+    MassDrop(MassDropSpec),
+    /// `kind = "pendulum"`: the hammer alone swinging on its flange.
+    Pendulum(PendulumSpec),
+    /// `kind = "touch"`: a finger, pressed or struck.
+    Touch(TouchSpec),
+    /// `kind = "motion"`: a prescribed key-front depth.
+    Motion(MotionSpec),
+}
+
+/// A force on the key front: `force_n` (N) from t = 0, reached after `ramp_s` if given
+/// (a linear ramp), released at `release_s` if given; or a table
+/// `points = [[time_s, force_n], ...]`, piecewise linear.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    /// Force (N).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_n: Option<f64>,
+    /// Rise time of a ramp (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ramp_s: Option<f64>,
+    /// Release time (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub release_s: Option<f64>,
+    /// `[time_s, force_n]` points, instead of `force_n`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+}
+
+/// A mass released on the key front from `height_m` (0: placed on it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassDropSpec {
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Drop height (m).
+    pub height_m: f64,
+}
+
+/// The hammer alone on its flange released from `release_angle_deg` off hanging (the
+/// pendulum or swing test); `model` is not used.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PendulumSpec {
+    /// Release angle from the hanging position (degrees).
+    pub release_angle_deg: f64,
+}
+
+/// A finger touch: `style = "pressed"` with `peak_force_n`, or `style = "struck"` with
+/// `finger_speed_m_s`; the finger's `finger_mass_g`, `rise_s` and `arm_damping_n_s_m`
+/// default to [`Finger::default`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TouchSpec {
+    /// `"pressed"` or `"struck"`.
+    pub style: TouchStyleName,
+    /// Peak force of a pressed touch (N).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_force_n: Option<f64>,
+    /// Arrival speed of a struck finger (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finger_speed_m_s: Option<f64>,
+    /// Effective finger mass (g).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finger_mass_g: Option<f64>,
+    /// Rise time of a pressed touch's force (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rise_s: Option<f64>,
+    /// Arm coupling of a struck touch (N·s/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_damping_n_s_m: Option<f64>,
+}
+
+/// Prescribed key-front depth below rest, `points = [[time_s, depth_mm], ...]`,
+/// piecewise linear, or read from `csv = "FILE"` (two columns, time_s and depth_mm, an
+/// optional header line; the path relative to the scenario file).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// `[time_s, depth_mm]` points.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+    /// A CSV file of the points, instead of `points`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub csv: Option<String>,
+}
+
+/// The `[input]` table of a scenario file as the spec of its `kind`; an error names the
+/// field inside it (`input.points[1][1]`).
+fn input_from_table(mut table: toml::Table) -> Result<InputSpec> {
+    const KINDS: &str = "force, mass_drop, pendulum, touch or motion";
+    let kind = match table.remove("kind") {
+        Some(toml::Value::String(k)) => k,
+        Some(other) => {
+            return Err(PianoError::scenario(
+                "input.kind",
+                format!("must be a string ({KINDS}), got {other}"),
+            ));
+        }
+        None => return Err(PianoError::scenario("input.kind", format!("missing ({KINDS})"))),
+    };
+    fn read<T: serde::de::DeserializeOwned>(table: toml::Table) -> Result<T> {
+        serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+            let message = e.inner().message().trim().to_string();
+            let mut field = match e.path().to_string() {
+                p if p == "." => "input".to_string(),
+                p => format!("input.{p}"),
+            };
+            // An unknown field is reported at its table: name the field itself.
+            if let Some(name) = message
+                .strip_prefix("unknown field `")
+                .and_then(|rest| rest.split('`').next())
+                && !field.ends_with(&format!(".{name}"))
+            {
+                field = format!("{field}.{name}");
+            }
+            PianoError::scenario(field, message)
+        })
+    }
+    Ok(match kind.as_str() {
+        "force" => InputSpec::Force(read(table)?),
+        "mass_drop" => InputSpec::MassDrop(read(table)?),
+        "pendulum" => InputSpec::Pendulum(read(table)?),
+        "touch" => InputSpec::Touch(read(table)?),
+        "motion" => InputSpec::Motion(read(table)?),
+        other => {
+            return Err(PianoError::scenario(
+                "input.kind",
+                format!("unknown kind '{other}' ({KINDS})"),
+            ));
+        }
+    })
 }
 
 /// The two touches of Goebl, Bresin & Galembo (2005).
@@ -95,21 +167,23 @@ impl InputSpec {
     /// The simulation input this spec describes; a missing or misplaced field is named.
     pub fn to_input(&self) -> Result<Input> {
         Ok(match self {
-            InputSpec::Force {
+            InputSpec::Force(ForceSpec {
                 force_n,
                 ramp_s,
                 release_s,
                 points,
-            } => force_input(*force_n, *ramp_s, *release_s, points.as_deref())?,
-            &InputSpec::MassDrop { mass_kg, height_m } => Input::MassDrop { mass_kg, height_m },
-            InputSpec::Pendulum { .. } => {
+            }) => force_input(*force_n, *ramp_s, *release_s, points.as_deref())?,
+            &InputSpec::MassDrop(MassDropSpec { mass_kg, height_m }) => {
+                Input::MassDrop { mass_kg, height_m }
+            }
+            InputSpec::Pendulum(PendulumSpec { .. }) => {
                 return Err(PianoError::scenario(
                     "input.kind",
                     "a pendulum scenario has no keystroke: run it with `swing` and \
                               `write_pendulum_dir`",
                 ));
             }
-            InputSpec::Motion { points, csv } => match (points, csv) {
+            InputSpec::Motion(MotionSpec { points, csv }) => match (points, csv) {
                 // Both: the points were read from the csv by `load`.
                 (Some(points), _) => Input::Motion {
                     points: points.iter().map(|p| (p[0], p[1])).collect(),
@@ -130,14 +204,14 @@ impl InputSpec {
                     ));
                 }
             },
-            &InputSpec::Touch {
+            &InputSpec::Touch(TouchSpec {
                 style,
                 peak_force_n,
                 finger_speed_m_s,
                 finger_mass_g,
                 rise_s,
                 arm_damping_n_s_m,
-            } => {
+            }) => {
                 let missing = |field: &str, style: &str| {
                     PianoError::scenario(
                         format!("input.{field}"),
@@ -327,7 +401,24 @@ fn default_output_step() -> f64 {
 impl Scenario {
     /// Parses a scenario and checks its values; errors name the field and its line.
     pub fn from_toml_str(text: &str) -> Result<Self> {
-        let scenario: Scenario = from_toml(text, InputKind::Scenario)?;
+        // Read in two stages: `input` is a table tagged by `kind`, and a tagged value loses
+        // the path of what is wrong inside it; read as the kind's own type it keeps it.
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct File {
+            model: String,
+            duration_s: f64,
+            #[serde(default = "default_output_step")]
+            output_step_s: f64,
+            input: toml::Table,
+        }
+        let file: File = from_toml(text, InputKind::Scenario)?;
+        let scenario = Scenario {
+            model: file.model,
+            duration_s: file.duration_s,
+            output_step_s: file.output_step_s,
+            input: input_from_table(file.input).map_err(|e| e.locate_in_toml(text))?,
+        };
         scenario.check().map_err(|e| e.locate_in_toml(text))?;
         Ok(scenario)
     }
@@ -335,22 +426,22 @@ impl Scenario {
     /// Checks what can be checked before running: the model, the duration and output step,
     /// and the input's values (a motion's `csv` is checked when [`Scenario::load`] reads it).
     pub fn check(&self) -> Result<()> {
-        if let InputSpec::Pendulum { release_angle_deg } = self.input {
+        if let InputSpec::Pendulum(PendulumSpec { release_angle_deg }) = self.input {
             crate::pendulum::check_release_angle(release_angle_deg)?;
         } else {
             self.model_kind()?;
         }
         crate::simulate::check_duration(self.duration_s, self.output_step_s)?;
         match &self.input {
-            InputSpec::Pendulum { .. } => Ok(()),
-            InputSpec::Motion {
+            InputSpec::Pendulum(PendulumSpec { .. }) => Ok(()),
+            InputSpec::Motion(MotionSpec {
                 points: None,
                 csv: Some(_),
-            } => Ok(()),
-            InputSpec::Motion {
+            }) => Ok(()),
+            InputSpec::Motion(MotionSpec {
                 points: Some(_),
                 csv: Some(_),
-            } => Err(PianoError::scenario(
+            }) => Err(PianoError::scenario(
                 "input.csv",
                 "give either points or csv, not both",
             )),
@@ -364,10 +455,10 @@ impl Scenario {
         let text = std::fs::read_to_string(path)
             .map_err(|e| PianoError::file(path, format!("cannot read the scenario: {e}")))?;
         let mut scenario = Self::from_toml_str(&text).map_err(|e| e.in_file(path))?;
-        if let InputSpec::Motion {
+        if let InputSpec::Motion(MotionSpec {
             points,
             csv: Some(file),
-        } = &mut scenario.input
+        }) = &mut scenario.input
         {
             let full = path.parent().unwrap_or(Path::new(".")).join(&*file);
             let text = std::fs::read_to_string(&full).map_err(|e| {

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use piano_action::ActionParams;
-use piano_action::scenario::{InputSpec, Scenario};
+use piano_action::scenario::{InputSpec, PendulumSpec, Scenario};
 
 fn dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios")
@@ -21,7 +21,7 @@ fn every_example_scenario_runs() {
         }
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         let scenario = Scenario::load(&path).unwrap();
-        if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
+        if let InputSpec::Pendulum(PendulumSpec { release_angle_deg }) = scenario.input {
             let swing =
                 piano_action::pendulum::swing(&params, release_angle_deg, scenario.duration_s)
                     .unwrap();
