@@ -241,6 +241,68 @@ pub struct ContactsParams {
     pub hammer_string: ContactParams,
 }
 
+impl ContactsParams {
+    /// The contacts by their field names.
+    pub fn named(&self) -> [(&'static str, &ContactParams); 10] {
+        [
+            ("front_rail", &self.front_rail),
+            ("back_rail", &self.back_rail),
+            ("capstan_heel", &self.capstan_heel),
+            ("jack_knuckle", &self.jack_knuckle),
+            ("lever_knuckle", &self.lever_knuckle),
+            ("let_off_button", &self.let_off_button),
+            ("drop_screw", &self.drop_screw),
+            ("backcheck", &self.backcheck),
+            ("rest_rail", &self.rest_rail),
+            ("hammer_string", &self.hammer_string),
+        ]
+    }
+
+    /// Checks every contact law: stiffness positive, exponent 1 to 5, restitution in
+    /// (0, 1], friction 0 to 2, naming the contact and the field (`contacts.backcheck.e`).
+    pub fn check(&self) -> Result<()> {
+        for (name, c) in self.named() {
+            let field = |f: &str| format!("contacts.{name}.{f}");
+            if !(c.k.is_finite() && c.k > 0.0) {
+                return Err(PianoError::params(
+                    field("k"),
+                    format!(
+                        "the {name} contact's stiffness must be positive, got {}",
+                        c.k
+                    ),
+                ));
+            }
+            // Felt and cloth laws have exponents 1.5-4 (Stulov; Hirschkorn et al. 2006);
+            // outside 1-5 is a typing error [D].
+            if !(1.0..=5.0).contains(&c.p) {
+                return Err(PianoError::params(
+                    field("p"),
+                    format!("the {name} contact's exponent must be 1 to 5, got {}", c.p),
+                ));
+            }
+            if !(c.e > 0.0 && c.e <= 1.0) {
+                return Err(PianoError::params(
+                    field("e"),
+                    format!(
+                        "the {name} contact's restitution must be in (0, 1] (1: no loss), got {}",
+                        c.e
+                    ),
+                ));
+            }
+            if !(0.0..=2.0).contains(&c.mu) {
+                return Err(PianoError::params(
+                    field("mu"),
+                    format!(
+                        "the {name} contact's friction coefficient must be 0 to 2, got {}",
+                        c.mu
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Numerical settings of the model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -346,6 +408,7 @@ impl ActionParams {
                 self.numerics.absolute_tolerance,
             ),
         ];
+        self.contacts.check()?;
         if self.numerics.event_samples == 0 {
             return Err(PianoError::params(
                 "numerics.event_samples",

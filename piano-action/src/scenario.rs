@@ -118,7 +118,12 @@ fn input_from_table(mut table: toml::Table) -> Result<InputSpec> {
                 format!("must be a string ({KINDS}), got {other}"),
             ));
         }
-        None => return Err(PianoError::scenario("input.kind", format!("missing ({KINDS})"))),
+        None => {
+            return Err(PianoError::scenario(
+                "input.kind",
+                format!("missing ({KINDS})"),
+            ));
+        }
     };
     fn read<T: serde::de::DeserializeOwned>(table: toml::Table) -> Result<T> {
         serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {

@@ -185,3 +185,17 @@ fn a_key_motion_can_come_from_a_csv_file_beside_the_scenario() {
     assert!(e.contains("input.csv") && e.contains("key.csv"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn blended_linear_refuses_an_empty_or_unordered_table_instead_of_panicking() {
+    use mbs_core::Drive;
+    use piano_action::simulate::BlendedLinear;
+    assert!(BlendedLinear::new(&[], 5e-3).is_err());
+    assert!(BlendedLinear::new(&[(0.0, 0.0), (0.0, 1.0)], 5e-3).is_err());
+    assert!(BlendedLinear::new(&[(0.0, f64::NAN)], 5e-3).is_err());
+    assert!(BlendedLinear::new(&[(0.0, 0.0)], -1.0).is_err());
+    // One point: a constant.
+    let one = BlendedLinear::new(&[(0.1, 2.0)], 5e-3).unwrap();
+    assert_eq!(one.eval(0.0).q, 2.0);
+    assert_eq!(one.eval(1.0).v, 0.0);
+}

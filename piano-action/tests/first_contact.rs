@@ -1,0 +1,235 @@
+//! What a new user hits in the first hour (issue 11): files are never overwritten without
+//! `--force`, absurd durations are refused before anything runs, and every error names what
+//! it is about (the parameter file, the scenario, a CSV, an option), the file, the line and
+//! the field.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn piano(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_piano"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh folder for one test.
+fn folder(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("piano-first-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+const LOUD: &str =
+    "model = \"double\"\nduration_s = 0.05\n[input]\nkind = \"force\"\nforce_n = 20.0\n";
+const SOFT: &str =
+    "model = \"double\"\nduration_s = 0.03\n[input]\nkind = \"force\"\nforce_n = 2.0\n";
+
+#[test]
+fn simulate_into_an_earlier_run_is_refused_and_force_replaces_only_run_files() {
+    let dir = folder("rerun");
+    let (loud, soft) = (dir.join("loud.toml"), dir.join("soft.toml"));
+    std::fs::write(&loud, LOUD).unwrap();
+    std::fs::write(&soft, SOFT).unwrap();
+    let run = dir.join("run");
+    let (ok, _, err) = piano(&["simulate", s(&loud), "--out", s(&run)]);
+    assert!(ok, "{err}");
+    let first = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
+    // The user's own files beside the run, and a stale figure of the first run.
+    std::fs::write(run.join("measured.csv"), "time_s,key_depth_mm\n0,0\n").unwrap();
+    std::fs::write(run.join("figure.svg"), "<svg/>").unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&soft), "--out", s(&run)]);
+    assert!(!ok, "a second run into the same folder must be refused");
+    assert!(
+        err.contains("holds an earlier run") && err.contains("--force"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(run.join("trajectory.csv")).unwrap(),
+        first
+    );
+    let (ok, _, err) = piano(&["simulate", s(&soft), "--out", s(&run), "--force"]);
+    assert!(ok, "{err}");
+    let second = std::fs::read_to_string(run.join("trajectory.csv")).unwrap();
+    assert_ne!(second, first);
+    assert_eq!(second.lines().count(), 1 + 31, "the soft run's 30 ms grid");
+    // Old and new are never mixed: the first run's figure is gone, the user's data stay.
+    assert!(!run.join("figure.svg").exists());
+    assert!(run.join("measured.csv").exists());
+    // A file where the folder should be is named.
+    let file = dir.join("file");
+    std::fs::write(&file, "x").unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&soft), "--out", s(&file)]);
+    assert!(!ok && err.contains("is a file, not a folder"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn plot_keeps_an_existing_figure_unless_forced() {
+    let dir = folder("plot");
+    let scenario = dir.join("loud.toml");
+    std::fs::write(&scenario, LOUD).unwrap();
+    let run = dir.join("run");
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&run)]);
+    assert!(ok, "{err}");
+    let figure = run.join("figure.svg");
+    std::fs::write(&figure, "my figure").unwrap();
+    let (ok, _, err) = piano(&["plot", s(&run)]);
+    assert!(
+        !ok && err.contains("exists") && err.contains("--force"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&figure).unwrap(), "my figure");
+    let (ok, _, err) = piano(&["plot", s(&run), "--force"]);
+    assert!(ok, "{err}");
+    assert!(std::fs::read_to_string(&figure).unwrap().contains("<svg"));
+    // The report: refused when it exists, replaced with --force.
+    let (ok, _, err) = piano(&["report", s(&run)]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = piano(&["report", s(&run)]);
+    assert!(!ok && err.contains("--force"), "{err}");
+    let (ok, _, err) = piano(&["report", s(&run), "--force"]);
+    assert!(ok, "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn absurd_durations_and_output_sizes_are_refused_before_running() {
+    let dir = folder("duration");
+    let scenario = dir.join("long.toml");
+    for (text, line, field, what) in [
+        (
+            LOUD.replace("0.05", "1e9"),
+            2,
+            "duration_s",
+            "longer than the 60 s",
+        ),
+        (LOUD.replace("0.05", "-1"), 2, "duration_s", "positive"),
+        (
+            LOUD.replace("duration_s = 0.05", "duration_s = 50\noutput_step_s = 1e-6"),
+            3,
+            "output_step_s",
+            "output points",
+        ),
+    ] {
+        std::fs::write(&scenario, &text).unwrap();
+        let out = dir.join("run");
+        let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&out)]);
+        assert!(!ok, "{text}");
+        assert!(
+            err.contains(&format!(
+                "scenario {}, line {line}, field `{field}`",
+                s(&scenario)
+            )) && err.contains(what),
+            "{err}"
+        );
+        assert!(!out.exists(), "nothing is written for a refused scenario");
+    }
+    // The same bound for sweeps.
+    let (ok, _, err) = piano(&["sweep", "--duration", "1e9", "--out", s(&dir.join("s.csv"))]);
+    assert!(!ok && err.contains("option --duration"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn errors_name_the_file_the_line_and_the_field() {
+    let dir = folder("errors");
+    // A bad cell in a points table: its own line, not the [input] header.
+    let scenario = dir.join("motion.toml");
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.1\n\n[input]\nkind = \"motion\"\npoints = [\n  [0.0, 0.0],\n  [0.01, \"x\"],\n]\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&dir.join("r"))]);
+    assert!(!ok);
+    assert!(
+        err.starts_with(&format!(
+            "error: scenario {}, line 8, field `input.points[1][1]`",
+            s(&scenario)
+        )),
+        "{err}"
+    );
+    assert!(!err.contains("parameters"), "{err}");
+    // A value that fails validation inside [input] is found on its line too.
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.1\n[input]\nkind = \"touch\"\nstyle = \"struck\"\nfinger_speed_m_s = 50.0\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&dir.join("r"))]);
+    assert!(
+        !ok && err.contains("line 6, field `input.finger_speed_m_s`"),
+        "{err}"
+    );
+    // A parameter file: the file, the line and the field of a validation error...
+    let (_, text, _) = piano(&["params"]);
+    let params = dir.join("params.toml");
+    let bad = text.replacen("e = 0.1 ", "e = 1.5 ", 1);
+    assert_ne!(
+        bad, text,
+        "the backcheck's restitution line is in the default file"
+    );
+    std::fs::write(&params, &bad).unwrap();
+    let line = bad.lines().position(|l| l.starts_with("e = 1.5")).unwrap() + 1;
+    let (ok, _, err) = piano(&["--params", s(&params), "touchweight"]);
+    assert!(!ok);
+    assert!(
+        err.contains(&format!(
+            "parameter file {}, line {line}, field `contacts.backcheck.e`",
+            s(&params)
+        )) && err.contains("backcheck contact's restitution"),
+        "{err}"
+    );
+    // ... and of a syntax error.
+    std::fs::write(&params, text.replacen("[hammer]", "[hammer", 1)).unwrap();
+    let (ok, _, err) = piano(&["--params", s(&params), "touchweight"]);
+    assert!(
+        !ok && err.contains(&format!("parameter file {}, line ", s(&params))),
+        "{err}"
+    );
+    // Options are named as options.
+    let (ok, _, err) = piano(&["sweep", "--jobs", "0", "--out", s(&dir.join("s.csv"))]);
+    assert!(!ok && err.contains("option --jobs"), "{err}");
+    let (ok, _, err) = piano(&["plot", s(&dir), "--format", "gif"]);
+    assert!(!ok && err.contains("option --format"), "{err}");
+    // A run folder that is not one is named as a run directory.
+    let (ok, _, err) = piano(&["report", s(&dir)]);
+    assert!(
+        !ok && err.contains(&format!("run directory {}", s(&dir))),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn negative_numbers_are_accepted_as_option_values() {
+    // `--from -1` is read as a value (and refused for what it is), not as an unknown flag.
+    let dir = folder("negative");
+    let (ok, _, err) = piano(&[
+        "sweep",
+        "--touch",
+        "force",
+        "--from",
+        "-1",
+        "--to",
+        "5",
+        "--out",
+        s(&dir.join("s.csv")),
+    ]);
+    assert!(
+        !ok && err.contains("option --from") && err.contains("-1"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
