@@ -199,3 +199,26 @@ fn blended_linear_refuses_an_empty_or_unordered_table_instead_of_panicking() {
     assert_eq!(one.eval(0.0).q, 2.0);
     assert_eq!(one.eval(1.0).v, 0.0);
 }
+
+#[test]
+fn a_run_reports_its_progress_step_by_step_up_to_its_duration() {
+    // What drives `piano simulate`'s progress bar for long runs.
+    let params = ActionParams::reference();
+    let mut seen: Vec<f64> = Vec::new();
+    let run = piano_action::simulate::simulate_observed(
+        &params,
+        ModelKind::Double,
+        &Input::Force {
+            force_n: 10.0,
+            release_s: None,
+        },
+        0.05,
+        1e-3,
+        &mut |t| seen.push(t),
+    )
+    .unwrap();
+    assert!(seen.len() > 10, "{} progress calls", seen.len());
+    assert!(seen.windows(2).all(|w| w[1] > w[0]), "times increase");
+    assert!((seen[seen.len() - 1] - 0.05).abs() < 1e-12);
+    assert!(!run.strikes.is_empty());
+}
