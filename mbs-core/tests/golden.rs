@@ -1,4 +1,4 @@
-//! Golden data: the 5-link planar chain of `shared/reference/planar5_reference.json`
+//! Golden data: the 5-link planar chain of `tests/data/planar5_reference.json`
 //! (Featherstone's `planar(5)`), with mass matrix, RNEA, nonlinear effects, gravity torques
 //! and ABA computed by Pinocchio 4.1.0 and cross-checked with MuJoCo 4.0.0. Reproduced to
 //! 1e-12.
