@@ -114,7 +114,9 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         .map_err(|e| bad(dir, format!("run.json scenario: {e}")))?;
     let params: ActionParams = serde_json::from_value(run["params"].clone())
         .map_err(|e| bad(dir, format!("run.json params: {e}")))?;
-    params.validate()?;
+    params
+        .validate()
+        .map_err(|e| e.in_file(&dir.join("run.json")))?;
     if matches!(scenario.input, InputSpec::Pendulum(PendulumSpec { .. })) {
         return Err(bad(
             dir,
