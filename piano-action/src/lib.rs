@@ -1,7 +1,8 @@
 //! # piano-action: the grand piano action on the planar multibody framework
 //!
 //! The parameter set (one documented TOML file, embedded as the default, loaded with
-//! errors that name the field); the three progressive models (simplified, single
+//! errors that name the field, and refused when its geometry cannot work:
+//! [`geometry_check`]); the three progressive models (simplified, single
 //! escapement, double escapement) assembled from it as `mbs_core::System`s with their
 //! joints, springs, pivot friction and felt contacts ([`Action`]); keystrokes
 //! ([`simulate()`]) driven by a force on the key front (constant, ramp, table, release), a
@@ -21,6 +22,7 @@
 mod action;
 pub mod drawing;
 mod error;
+pub mod geometry_check;
 pub mod measured;
 pub mod params;
 pub mod pendulum;

@@ -373,7 +373,8 @@ impl ActionParams {
     }
 
     /// Checks every number is finite and every mass, inertia, radius and stiffness is
-    /// positive, naming the first bad field.
+    /// positive, naming the first bad field; then that the geometry and body data describe
+    /// an action that can work ([`crate::geometry_check`]).
     pub fn validate(&self) -> Result<()> {
         let table = toml::Table::try_from(self)
             .map_err(|e| PianoError::params(String::new(), e.to_string()))?;
@@ -423,7 +424,7 @@ impl ActionParams {
                 ));
             }
         }
-        Ok(())
+        crate::geometry_check::ensure_plausible(self)
     }
 
     /// The parameters as TOML text (for `piano params`; the embedded default keeps its

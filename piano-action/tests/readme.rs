@@ -20,7 +20,10 @@ fn the_readme_points_only_inside_the_repository() {
             && !path.contains(' ')
             && !path.contains('*');
         if looks_like_path {
-            assert!(root.join(path).exists(), "README names {path}, which is not here");
+            assert!(
+                root.join(path).exists(),
+                "README names {path}, which is not here"
+            );
         }
     }
 }
@@ -32,7 +35,10 @@ fn the_readme_examples_write_under_target_and_set_up_takes_two_commands() {
         let after = line.split("--out ").nth(1).unwrap_or("");
         let dir = after.split(['`', ' ']).next().unwrap_or("");
         assert!(
-            dir.is_empty() || dir.starts_with("target/") || dir.contains("DIR") || dir.contains("FILE"),
+            dir.is_empty()
+                || dir.starts_with("target/")
+                || dir.contains("DIR")
+                || dir.contains("FILE"),
             "an example writes {dir} into the checkout: {line}"
         );
     }
@@ -47,5 +53,8 @@ fn the_readme_examples_write_under_target_and_set_up_takes_two_commands() {
         .map(|block| block.split("```").next().unwrap().trim())
         .collect();
     assert_eq!(commands, ["cargo run --release", "cargo test --workspace"]);
-    assert!(setup.contains("few minutes"), "the cold build's time is said");
+    assert!(
+        setup.contains("few minutes"),
+        "the cold build's time is said"
+    );
 }
