@@ -105,6 +105,61 @@ fn describe(input: &InputSpec) -> String {
     }
 }
 
+/// Two onsets of the same contact closer than this are chatter, not a new event (s).
+pub const CHATTER_S: f64 = 0.005;
+
+/// The events of a run a reader should see, from the complete list of `events.json`
+/// (objects with `name` and `time_s`, in time order), in time order. Left out:
+/// - releases and lifts (`*_release`, `*_lift`): the end of what the onset started;
+/// - chatter: the same event again within [`CHATTER_S`] of its last occurrence;
+/// - a `let_off` before the jack has been reset (`jack_reset`) since the last one: the
+///   escaped jack's toe touching its button again is not a new let-off;
+/// - a `check_catch` with no string contact since the last one: the hammer bouncing on the
+///   backcheck is not a new check.
+///
+/// `events.json` itself stays complete.
+pub fn listed_events(events: &[Value]) -> Vec<Value> {
+    let mut out: Vec<Value> = Vec::new();
+    let (mut jack_out, mut struck_since_check, mut checked) = (false, false, false);
+    let mut last_seen = std::collections::BTreeMap::new();
+    for e in events {
+        let (Some(name), Some(t)) = (e["name"].as_str(), e["time_s"].as_f64()) else {
+            continue;
+        };
+        match name {
+            "jack_reset" => jack_out = false,
+            "string_contact_start" => struck_since_check = true,
+            _ => {}
+        }
+        if name.ends_with("_release") || name.ends_with("_lift") {
+            continue;
+        }
+        let before = last_seen.insert(name, t);
+        if before.is_some_and(|before| t - before <= CHATTER_S) {
+            continue;
+        }
+        match name {
+            "let_off" if jack_out => continue,
+            "let_off" => jack_out = true,
+            "check_catch" if checked && !struck_since_check => continue,
+            "check_catch" => (checked, struck_since_check) = (true, false),
+            _ => {}
+        }
+        out.push(e.clone());
+    }
+    out
+}
+
+/// How a contact is named for a reader: its name with spaces, and the presser's pad by
+/// what presses (a finger, or the dropped mass).
+fn contact_label(name: &str, input: &InputSpec) -> String {
+    match (name, input) {
+        ("presser_key", InputSpec::MassDrop { .. }) => "mass on key".into(),
+        ("presser_key", _) => "finger on key".into(),
+        _ => name.replace('_', " "),
+    }
+}
+
 /// The report data of one run directory (see the module docs).
 pub fn run_data(dir: &Path) -> Result<Value> {
     let run = read_json(dir, "run.json")?;
@@ -273,11 +328,16 @@ pub fn run_data(dir: &Path) -> Result<Value> {
             )
         })
         .collect();
+    let contact_labels: serde_json::Map<String, Value> = contact_names
+        .iter()
+        .map(|c| (c.to_string(), json!(contact_label(c, &scenario.input))))
+        .collect();
     let measured = read_measured(dir, &series)?;
     let series_json: Vec<Value> = series
         .into_iter()
         .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
         .collect();
+    let events = read_json(dir, "events.json")?;
     let name = dir
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
@@ -290,8 +350,10 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         "t": t,
         "carry": carry_json,
         "contacts": forces_json,
+        "contact_labels": contact_labels,
         "series": series_json,
-        "events": read_json(dir, "events.json")?,
+        "events": events,
+        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
         "summary": read_json(dir, "summary.json")?,
         "zoom": zoom,
         "measured": measured,
