@@ -24,8 +24,9 @@ use std::fmt::Write;
 use mbs_contact::{Contact, Shape};
 use mbs_core::{CoreError, Data, Transform, frame_pose, update_poses};
 
-use crate::action::{Action, ModelKind, PRESSER_PAD_RADIUS_MM, Presser};
+use crate::action::{Action, PRESSER_PAD_RADIUS_MM, Presser};
 use crate::error::Result;
+use crate::params::ActionParams;
 
 /// Blank space around the action's outline on every side of the drawing (mm).
 pub const MARGIN_MM: f64 = 12.0;
@@ -249,12 +250,8 @@ impl BackcheckFace {
     /// Built as [`Action::build`] builds the contact: the face through the catch point at
     /// its angle, turned so the tail at rest lies on its outward side, moved along that
     /// normal by the regulation's offset.
-    fn of(action: &Action) -> Self {
-        let (k, g, h) = (
-            &action.params.key,
-            &action.params.regulation,
-            &action.params.hammer,
-        );
+    fn of(params: &ActionParams) -> Self {
+        let (k, g, h) = (&params.key, &params.regulation, &params.hammer);
         let a = k.backcheck_face_angle_deg.to_radians();
         let mut d = [a.cos(), a.sin()];
         let (s, c) = h.rest_angle_deg.to_radians().sin_cos();
@@ -305,7 +302,7 @@ impl BackcheckFace {
 fn backcheck_part(action: &Action) -> Part {
     let k = &action.params.key;
     let mut part = Part::new("key-backcheck", Some("key"));
-    let face = BackcheckFace::of(action);
+    let face = BackcheckFace::of(&action.params);
     let foot = face.wire_foot();
     part.wire(vec![foot, [foot[0], k.finger_mm[1]]], 1.2, METAL_FILL);
     let [leather, block] = face.head();
@@ -447,20 +444,22 @@ fn lever_part(action: &Action) -> Part {
 }
 
 /// The hammer in its shank frame: butt with the knuckle, shank, moulding with the tail,
-/// felt with its crown; carried to the rest layout by the hammer's rest pose.
+/// felt with its crown; placed in the world by `rest` (its pose in the layout, for the
+/// action).
 ///
 /// The moulding is cut to the contact geometry: its back runs from the tail catch point
 /// parallel to the backcheck face as it stands at rest, so the tail is the moulding's
 /// lowest rear point, the catch face passes through it, and the backcheck (which stands
 /// behind that line at rest) never lies inside the head. Where the backcheck reaches up
 /// under the crown, the felt behind the moulding stops above the backcheck's top.
-fn hammer_part(action: &Action, rest: &Transform) -> Part {
-    let h = &action.params.hammer;
+fn hammer_part(params: &ActionParams, rest: &Transform) -> Part {
+    let h = &params.hammer;
     let mut part = Part::new("body-hammer", Some("hammer"));
     let to_rest = |q: P| map(rest, q);
     let place = |pts: Vec<P>| pts.into_iter().map(to_rest).collect::<Vec<_>>();
+    // The shape is cut against the backcheck where the layout puts them both.
     let to_body = {
-        let inverse = rest.inverse();
+        let inverse = hammer_layout_pose(params).inverse();
         move |q: P| map(&inverse, q)
     };
     let (k, kr) = (h.knuckle_body_mm, h.knuckle_radius_mm);
@@ -472,7 +471,7 @@ fn hammer_part(action: &Action, rest: &Transform) -> Part {
 
     // The backcheck at rest, in the shank frame: its face direction (pointing up the head)
     // and outward normal (toward the tail).
-    let face = BackcheckFace::of(action);
+    let face = BackcheckFace::of(params);
     let lo = to_body(face.lo);
     let mut up = unit(sub(to_body(face.hi), lo), [0.0, 1.0]);
     if up[1] < 0.0 {
@@ -743,25 +742,7 @@ fn fixed_part(action: &Action) -> Part {
     }
     // Hammer flange and its rail; the drop screw goes down through the flange.
     let hp = h.pivot_mm;
-    part.polygon(
-        rect([hp[0] - 27.0, hp[0] - 7.0], [hp[1] - 8.0, hp[1] + 9.0]),
-        RAIL_FILL,
-    );
-    part.polygon(
-        vec![
-            [hp[0] - 7.0, hp[1] + 8.0],
-            [hp[0] + 5.0, hp[1] + 6.0],
-            [hp[0] + 5.0, hp[1] - 5.0],
-            [hp[0] - 7.0, hp[1] - 7.0],
-        ],
-        RAIL_FILL,
-    );
-    part.label(
-        [hp[0] - 17.0, hp[1] - 1.0],
-        [0.0, 0.0],
-        "flange rail",
-        "middle",
-    );
+    add_hammer_flange(&mut part, hp, "flange rail");
     if action.contacts.contains_key("drop_screw") {
         let (x, y) = (g.drop_screw_x_mm, g.drop_screw_y_mm);
         let c = 0.5 * (x[0] + x[1]);
@@ -850,6 +831,117 @@ fn place_label(at: P, text: &str, align: &str, placed: &mut Vec<[f64; 4]>) -> P 
     }
     placed.push(label_box(chosen, text, align));
     chosen
+}
+
+/// The hammer flange on its rail, the hammer's centre pin at `hp`; the rail named `name`.
+fn add_hammer_flange(part: &mut Part, hp: P, name: &str) {
+    part.polygon(
+        rect([hp[0] - 27.0, hp[0] - 7.0], [hp[1] - 8.0, hp[1] + 9.0]),
+        RAIL_FILL,
+    );
+    part.polygon(
+        vec![
+            [hp[0] - 7.0, hp[1] + 8.0],
+            [hp[0] + 5.0, hp[1] + 6.0],
+            [hp[0] + 5.0, hp[1] - 5.0],
+            [hp[0] - 7.0, hp[1] - 7.0],
+        ],
+        RAIL_FILL,
+    );
+    part.label([hp[0] - 17.0, hp[1] - 1.0], [0.0, 0.0], name, "middle");
+}
+
+/// The parts of the swing test: the hammer flange clamped on its rail, and the hammer with
+/// its shank at `shank_angle_rad` in the world.
+fn pendulum_parts(params: &ActionParams, shank_angle_rad: f64) -> Vec<Part> {
+    // The flange is a fork round the butt: seen through the hammer, dashed, with the clamp
+    // that holds it above, out of the swing's way.
+    let hp = params.hammer.pivot_mm;
+    let mut flange = Part::new("fixed-parts", None);
+    flange.behind = true;
+    flange.polygon(
+        vec![
+            [hp[0] - 7.0, hp[1] + 10.0],
+            [hp[0] + 7.0, hp[1] + 10.0],
+            [hp[0] + 5.0, hp[1] - 5.0],
+            [hp[0] - 5.0, hp[1] - 5.0],
+        ],
+        RAIL_FILL,
+    );
+    flange.polygon(
+        rect([hp[0] - 20.0, hp[0] + 20.0], [hp[1] + 10.0, hp[1] + 22.0]),
+        METAL_FILL,
+    );
+    flange.label(
+        [hp[0] + 20.0, hp[1] + 16.0],
+        [4.0, 0.0],
+        "flange, clamped",
+        "start",
+    );
+    vec![
+        flange,
+        hammer_part(params, &hammer_pose(params, shank_angle_rad)),
+    ]
+}
+
+/// The hammer's pose (metres) with its shank at `shank_angle_rad` about its flange pin.
+fn hammer_pose(params: &ActionParams, shank_angle_rad: f64) -> Transform {
+    let h = &params.hammer;
+    Transform::new(shank_angle_rad, h.pivot_mm[0] * 1e-3, h.pivot_mm[1] * 1e-3)
+}
+
+/// The hammer's pose in the layout: the shank at its rest angle.
+fn hammer_layout_pose(params: &ActionParams) -> Transform {
+    hammer_pose(params, params.hammer.rest_angle_deg.to_radians())
+}
+
+/// The swing test drawn to scale: the hammer on its clamped flange with its shank at
+/// `shank_angle_rad` in the world (radians, counter-clockwise from the x axis; hanging is
+/// [`crate::pendulum::Swing::hanging_shank_angle_rad`]), titled `title`. The hammer is the
+/// one [`action_svg`] draws (group `body-hammer`); the flange is `fixed-parts`.
+///
+/// Errors: a non-finite angle.
+pub fn pendulum_svg(params: &ActionParams, shank_angle_rad: f64, title: &str) -> Result<String> {
+    if !shank_angle_rad.is_finite() {
+        return Err(CoreError::NonFiniteInput {
+            what: "shank angle",
+            index: 0,
+            value: shank_angle_rad,
+        }
+        .into());
+    }
+    Ok(render(
+        &pendulum_parts(params, shank_angle_rad),
+        &BTreeMap::new(),
+        &[],
+        "the hammer swinging on its flange; white dot: its centre pin",
+        title,
+    ))
+}
+
+/// The swing test as data for a viewer that moves it (see [`scene`]): the clamped flange
+/// and the hammer (frame `"hammer"`) hanging, its shank at `hanging_shank_angle_rad`; no
+/// contacts.
+pub fn pendulum_scene(params: &ActionParams, hanging_shank_angle_rad: f64) -> serde_json::Value {
+    serde_json::json!({
+        "frames": ["hammer"],
+        "parts": parts_json(&pendulum_parts(params, hanging_shank_angle_rad)),
+        "contacts": [],
+    })
+}
+
+/// The motion `[angle (rad), x (mm), y (mm)]` carrying the swing test's hammer from its
+/// place in [`pendulum_scene`] (hanging) to `angle_from_hanging_rad` from there: a turn
+/// about the flange pin.
+pub fn pendulum_carry(params: &ActionParams, angle_from_hanging_rad: f64) -> [f64; 3] {
+    let p = params.hammer.pivot_mm;
+    let (s, c) = angle_from_hanging_rad.sin_cos();
+    // x' = R (x − p) + p, so the translation is p − R p.
+    [
+        angle_from_hanging_rad,
+        p[0] - (c * p[0] - s * p[1]),
+        p[1] - (s * p[0] + c * p[1]),
+    ]
 }
 
 /// Bounding box of the drawn points (mm).
@@ -1049,7 +1141,24 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
     }
 
     let parts = build_parts(action, &rest);
+    let legend = format!(
+        "contact shapes of the {} model; white dots: pivots",
+        action.kind.name()
+    );
+    Ok(render(&parts, &carry, &contacts, &legend, title))
+}
 
+/// The SVG document of `parts`, each carried from its rest place by its frame's motion in
+/// `carry` (fixed parts and frames not in it stay), with the contacts' shapes and pressed
+/// dots over them, the part names, and `title` and `legend` (the line under the pressed
+/// contacts).
+fn render(
+    parts: &[Part],
+    carry: &BTreeMap<&'static str, Transform>,
+    contacts: &[ContactView],
+    legend: &str,
+    title: &str,
+) -> String {
     let mut svg = Svg {
         body: String::new(),
         bounds: Bounds::new(),
@@ -1062,7 +1171,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
             .unwrap_or(Transform::IDENTITY)
     };
     let hidden = r##"stroke="#8c8c8c" stroke-width="0.3" stroke-dasharray="1.5 1""##;
-    for part in &parts {
+    for part in parts {
         let x_part = carried(part);
         let outline = if part.behind { hidden } else { outline };
         svg.open(&format!(r#"id="{}""#, part.id));
@@ -1094,7 +1203,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         svg.close();
     }
     svg.open(r#"id="contact-shapes""#);
-    for c in &contacts {
+    for c in contacts {
         svg.open(&format!(r#"id="contact-{}""#, c.name));
         for s in &c.shapes {
             draw_shape(&mut svg, s);
@@ -1120,7 +1229,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         r##"id="labels" font-size="{LABEL_FONT_MM}" fill="#222222""##
     ));
     let mut placed: Vec<[f64; 4]> = Vec::new();
-    for part in &parts {
+    for part in parts {
         let x_part = carried(part);
         for l in &part.labels {
             let a = map(&x_part, l.anchor);
@@ -1133,14 +1242,31 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
     }
     svg.close();
 
-    Ok(frame_document(svg, &contacts, action.kind, title))
+    frame_document(svg, contacts, legend, title)
 }
 
 /// Wraps the drawing in its document: white page fitted around the action with a margin,
 /// title above, legend and scale bar below.
-fn frame_document(svg: Svg, contacts: &[ContactView], kind: ModelKind, title: &str) -> String {
+fn frame_document(svg: Svg, contacts: &[ContactView], legend: &str, title: &str) -> String {
     let b = svg.bounds;
-    let (x0, x1) = (b.min[0] - MARGIN_MM, b.max[0] + MARGIN_MM);
+    // Wide enough for the title and the legend beside the scale bar (text at 0.6 em a
+    // character).
+    let active: Vec<&str> = contacts
+        .iter()
+        .filter(|c| c.active)
+        .map(|c| c.name)
+        .collect();
+    let list = if active.is_empty() {
+        "none".to_string()
+    } else {
+        active.join(", ")
+    };
+    let pressed = format!("contacts pressed: {list}");
+    let text_w = |text: &str, size: f64| 0.6 * size * text.chars().count() as f64;
+    let right = (b.max[0])
+        .max(b.min[0] + text_w(title, 6.0))
+        .max(b.min[0] + 4.5 + text_w(legend, 3.5).max(text_w(&pressed, 3.5)) + 6.0 + SCALE_BAR_MM);
+    let (x0, x1) = (b.min[0] - MARGIN_MM, right + MARGIN_MM);
     // SVG y runs down: the top of the page is above the action's highest point.
     let top = -b.max[1] - MARGIN_MM - TITLE_SPACE;
     let bottom = -b.min[1] + MARGIN_MM + LEGEND_SPACE;
@@ -1164,50 +1290,43 @@ fn frame_document(svg: Svg, contacts: &[ContactView], kind: ModelKind, title: &s
     out.push_str(&svg.body);
 
     // Legend: pressed contacts, and what the thin lines are.
-    let active: Vec<&str> = contacts
-        .iter()
-        .filter(|c| c.active)
-        .map(|c| c.name)
-        .collect();
     let y0 = -b.min[1] + MARGIN_MM;
     let _ = writeln!(out, r##"<g id="legend" font-size="3.5" fill="#222222">"##);
+    // Without contacts (the swing test) only the legend line stands.
+    if !contacts.is_empty() {
+        let _ = writeln!(
+            out,
+            r#"<circle cx="{:.2}" cy="{:.2}" r="1.4" fill="{ACTIVE_FILL}"/>"#,
+            b.min[0] + 1.4,
+            y0 - 1.2
+        );
+        let _ = writeln!(
+            out,
+            r#"<text x="{:.2}" y="{:.2}">{}</text>"#,
+            b.min[0] + 4.5,
+            y0,
+            escape(&pressed)
+        );
+        let _ = writeln!(
+            out,
+            r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="{CONTACT_STROKE}" stroke-width="0.25"/>"#,
+            b.min[0],
+            y0 + 4.8,
+            b.min[0] + 3.0,
+            y0 + 4.8
+        );
+    }
     let _ = writeln!(
         out,
-        r#"<circle cx="{:.2}" cy="{:.2}" r="1.4" fill="{ACTIVE_FILL}"/>"#,
-        b.min[0] + 1.4,
-        y0 - 1.2
-    );
-    let list = if active.is_empty() {
-        "none".to_string()
-    } else {
-        active.join(", ")
-    };
-    let _ = writeln!(
-        out,
-        r#"<text x="{:.2}" y="{:.2}">contacts pressed: {}</text>"#,
-        b.min[0] + 4.5,
-        y0,
-        escape(&list)
-    );
-    let _ = writeln!(
-        out,
-        r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="{CONTACT_STROKE}" stroke-width="0.25"/>"#,
-        b.min[0],
-        y0 + 4.8,
-        b.min[0] + 3.0,
-        y0 + 4.8
-    );
-    let _ = writeln!(
-        out,
-        r#"<text x="{:.2}" y="{:.2}">contact shapes of the {} model; white dots: pivots</text>"#,
+        r#"<text x="{:.2}" y="{:.2}">{}</text>"#,
         b.min[0] + 4.5,
         y0 + 6.0,
-        kind.name()
+        escape(legend)
     );
     out.push_str("</g>\n");
 
     // Scale bar at the bottom right.
-    let (sx1, sy) = (b.max[0], y0 + 4.0);
+    let (sx1, sy) = (right, y0 + 4.0);
     let sx0 = sx1 - SCALE_BAR_MM;
     let _ = writeln!(
         out,
@@ -1286,7 +1405,7 @@ fn build_parts(action: &Action, rest: &BTreeMap<&'static str, Transform>) -> Vec
         parts.push(jack_part(action));
     }
     if let Some(x0) = rest.get("hammer") {
-        parts.push(hammer_part(action, x0));
+        parts.push(hammer_part(&action.params, x0));
     }
     if action.contacts.contains_key("backcheck") {
         parts.push(backcheck_part(action));
@@ -1307,26 +1426,9 @@ fn json_points(pts: &[P]) -> serde_json::Value {
         .collect()
 }
 
-/// The drawing as data, for a viewer that moves it (the report): every part's outlines in
-/// its rest place (mm, world, y up) with the frame that carries it (`null`: fixed), pivots
-/// and labels; and every contact's shapes in their rest places, each with the frame of its
-/// side. Move a part by its frame's [`carry`] transform.
-pub fn scene(action: &Action) -> Result<serde_json::Value> {
-    let (rest, _) = {
-        let x = action.layout_state()?;
-        let first =
-            action
-                .contacts
-                .values()
-                .next()
-                .copied()
-                .ok_or_else(|| CoreError::UnknownName {
-                    what: "contact",
-                    name: "any (the action has none)".into(),
-                })?;
-        rest_and_carry(action, 0.0, &x, first)?
-    };
-    let parts: Vec<serde_json::Value> = build_parts(action, &rest)
+/// Parts as data: outlines in their rest places, frame, pivots and labels.
+fn parts_json(parts: &[Part]) -> Vec<serde_json::Value> {
+    parts
         .iter()
         .map(|part| {
             let pieces: Vec<serde_json::Value> = part
@@ -1363,7 +1465,29 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
                 "labels": labels,
             })
         })
-        .collect();
+        .collect()
+}
+
+/// The drawing as data, for a viewer that moves it (the report): every part's outlines in
+/// its rest place (mm, world, y up) with the frame that carries it (`null`: fixed), pivots
+/// and labels; and every contact's shapes in their rest places, each with the frame of its
+/// side. Move a part by its frame's [`carry`] transform.
+pub fn scene(action: &Action) -> Result<serde_json::Value> {
+    let (rest, _) = {
+        let x = action.layout_state()?;
+        let first =
+            action
+                .contacts
+                .values()
+                .next()
+                .copied()
+                .ok_or_else(|| CoreError::UnknownName {
+                    what: "contact",
+                    name: "any (the action has none)".into(),
+                })?;
+        rest_and_carry(action, 0.0, &x, first)?
+    };
+    let parts = parts_json(&build_parts(action, &rest));
     // Contact shapes in their rest places (mm), by side.
     let model = action.system.model();
     let mut contacts = Vec::new();

@@ -134,8 +134,13 @@ fn simulate_scenario(
     use piano_action::scenario::{InputSpec, Scenario, write_pendulum_dir, write_run_dir};
     let scenario = Scenario::load(path).map_err(|e| e.to_string())?;
     if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
-        let swing = piano_action::pendulum::swing(params, release_angle_deg, scenario.duration_s)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let swing = piano_action::pendulum::swing_sampled(
+            params,
+            release_angle_deg,
+            scenario.duration_s,
+            scenario.output_step_s,
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
         write_pendulum_dir(out, &scenario, params, &swing).map_err(|e| e.to_string())?;
         println!(
             "hammer swing: {} turning points in {} s",
@@ -144,7 +149,7 @@ fn simulate_scenario(
         );
         println!("run directory: {}", out.display());
         if report {
-            println!("(a pendulum run has no report: its summary.json has the swing)");
+            write_report(&[out.to_path_buf()], &out.join("report.html"))?;
         }
         return Ok(());
     }

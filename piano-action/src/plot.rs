@@ -215,7 +215,7 @@ fn marks(run: &Value) -> Vec<Mark> {
             Some("check_catch") => ("check", RGBColor(183, 149, 11)),
             Some("drop") => ("drop", RGBColor(52, 73, 94)),
             Some("jack_reset") => ("jack reset", RGBColor(142, 68, 173)),
-            Some("turn") => ("turn", RGBColor(90, 90, 90)),
+            Some("turn") => ("turn", RGBColor(176, 58, 146)),
             _ => continue,
         };
         if let Some(t) = e["time_s"].as_f64() {

@@ -168,11 +168,8 @@ pub fn run_data(dir: &Path) -> Result<Value> {
     let params: ActionParams = serde_json::from_value(run["params"].clone())
         .map_err(|e| bad(dir, format!("run.json params: {e}")))?;
     params.validate()?;
-    if matches!(scenario.input, InputSpec::Pendulum { .. }) {
-        return Err(bad(
-            dir,
-            "a pendulum run has no keystroke to replay (its summary.json has the swing)".into(),
-        ));
+    if let InputSpec::Pendulum { release_angle_deg } = scenario.input {
+        return pendulum_data(dir, &params, release_angle_deg);
     }
     let kind: ModelKind = scenario.model_kind()?;
     let Prepared {
@@ -356,6 +353,92 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
         "summary": read_json(dir, "summary.json")?,
         "zoom": zoom,
+        "measured": measured,
+    }))
+}
+
+/// The report data of a pendulum run directory: the hammer hanging on its flange and
+/// swinging by the angle in `trajectory.csv`, the angle, the strike point's speed and the
+/// energies against time, the turning points as events. No key, no contacts.
+fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> Result<Value> {
+    let (header, rows) = read_trajectory(dir)?;
+    if header != ["time_s", "hammer_q", "hammer_v"] {
+        return Err(bad(
+            dir,
+            "trajectory.csv of a pendulum run has the columns time_s, hammer_q, hammer_v".into(),
+        ));
+    }
+    let h = &params.hammer;
+    let hanging = crate::pendulum::hanging_shank_angle_rad(params);
+    let mass = h.mass_g * 1e-3;
+    let com = h.com_body_mm[0].hypot(h.com_body_mm[1]) * 1e-3;
+    let inertia_pin = h.inertia_com_kg_m2 + mass * com * com;
+    let strike_radius_m = h.strike_body_mm[0].hypot(h.strike_body_mm[1]) * 1e-3;
+    let (mut t, mut carry) = (Vec::new(), [Vec::new(), Vec::new(), Vec::new()]);
+    let mut series: Vec<(&str, &str, Vec<f64>)> = vec![
+        (
+            "hammer_angle_deg",
+            "hammer angle from hanging (°)",
+            Vec::new(),
+        ),
+        (
+            "hammer_speed_m_s",
+            "hammer speed at the strike point (m/s)",
+            Vec::new(),
+        ),
+        ("kinetic_mj", "kinetic energy (mJ)", Vec::new()),
+        (
+            "gravity_mj",
+            "gravitational energy from the release (mJ)",
+            Vec::new(),
+        ),
+    ];
+    let q0 = rows[0][1];
+    for row in &rows {
+        let (time, q, w) = (row[0], row[1], row[2]);
+        t.push(r(time, 6));
+        for (slot, v) in carry
+            .iter_mut()
+            .zip(crate::drawing::pendulum_carry(params, q))
+        {
+            slot.push(r(v, 6));
+        }
+        // The centre of mass is d cos q below the pin.
+        let values = [
+            q.to_degrees(),
+            w * strike_radius_m,
+            0.5 * inertia_pin * w * w * 1e3,
+            mass * 9.81 * com * (q0.cos() - q.cos()) * 1e3,
+        ];
+        for (s, v) in series.iter_mut().zip(values) {
+            s.2.push(r(v, 4));
+        }
+    }
+    let events = read_json(dir, "events.json")?;
+    let measured = read_measured(dir, &series)?;
+    let series_json: Vec<Value> = series
+        .into_iter()
+        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
+        .collect();
+    let [a, x, y] = carry;
+    let name = dir
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string());
+    Ok(json!({
+        "name": name,
+        "title": format!("hammer swing, released {release_angle_deg}° from hanging"),
+        "model": "pendulum",
+        "scene": crate::drawing::pendulum_scene(params, hanging),
+        "t": t,
+        "carry": {"hammer": {"a": a, "x": x, "y": y}},
+        "contacts": {},
+        "contact_labels": {},
+        "series": series_json,
+        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
+        "events": events,
+        "summary": read_json(dir, "summary.json")?,
+        "zoom": {},
         "measured": measured,
     }))
 }

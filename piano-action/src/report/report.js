@@ -158,8 +158,9 @@
     const box = el('section', { class: 'view', id: 'view-' + k }, main);
     el('h2', {}, box, (RUNS.length > 1 ? '[' + (k + 1) + '] ' : '') + run.title + ' — 2D, to scale');
     const canvas = el('canvas', { id: 'canvas2d-' + k, 'aria-label': '2D view of ' + run.title }, box);
-    el('div', { class: 'note' }, box,
-      'Drag to pan, wheel to zoom. Arrows: the contact forces on the moving part, one colour per contact, named beside them; length on a log scale (legend at the bottom left).');
+    el('div', { class: 'note' }, box, 'Drag to pan, wheel to zoom.' + (Object.keys(run.contacts).length
+      ? ' Arrows: the contact forces on the moving part, one colour per contact, named beside them; length on a log scale (legend at the bottom left).'
+      : ''));
     const view = { run, canvas, box, bounds: sceneBounds(run.scene), center: null, halfWidth: null };
     fitZoom(view, 'whole action');
     let drag = null;
@@ -350,17 +351,19 @@
     ctx.textAlign = 'center'; ctx.fillText(bar + ' mm', bx + (bar * s) / 2, by - 9 * dpr);
     placed.push([bx - 4 * dpr, by - 17 * dpr, bx + bar * s + 4 * dpr, H]);
     ctx.textAlign = 'left';
-    // Arrow legend: length only (the colour names the contact).
-    let lx = 10 * dpr;
-    const ly = H - 14 * dpr;
-    ctx.fillStyle = '#444'; ctx.strokeStyle = '#444'; ctx.lineWidth = 2 * dpr;
-    for (const f of [1, 10, 100]) {
-      const len = arrowPx(f, state.gain) * dpr;
-      ctx.beginPath(); ctx.moveTo(lx, ly); ctx.lineTo(lx + len, ly); ctx.stroke();
-      ctx.fillText(f + ' N', lx + len + 3 * dpr, ly);
-      lx += len + 40 * dpr;
+    // Arrow legend: length only (the colour names the contact); none without contacts.
+    if (Object.keys(run.contacts).length) {
+      let lx = 10 * dpr;
+      const ly = H - 14 * dpr;
+      ctx.fillStyle = '#444'; ctx.strokeStyle = '#444'; ctx.lineWidth = 2 * dpr;
+      for (const f of [1, 10, 100]) {
+        const len = arrowPx(f, state.gain) * dpr;
+        ctx.beginPath(); ctx.moveTo(lx, ly); ctx.lineTo(lx + len, ly); ctx.stroke();
+        ctx.fillText(f + ' N', lx + len + 3 * dpr, ly);
+        lx += len + 40 * dpr;
+      }
+      placed.push([0, ly - 9 * dpr, lx, H]);
     }
-    placed.push([0, ly - 9 * dpr, lx, H]);
 
     // Force arrows on the moving part, log scaled in screen pixels so they read at any
     // zoom: 0.1 N, 1 N, 10 N and 100 N are equal steps (see the legend).
@@ -574,7 +577,8 @@
       color: gl.getUniformLocation(prog, 'color'), light: gl.getUniformLocation(prog, 'light'),
     };
     view.target = [(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2, 0];
-    view.distance = 1.3 * Math.max(b.x1 - b.x0, b.y1 - b.y0);
+    // Far enough back for the whole width, and for the whole height (a hanging hammer).
+    view.distance = Math.max(1.3 * (b.x1 - b.x0), 1.9 * (b.y1 - b.y0));
     view.azimuth = -0.42;
     view.elevation = 0.22;
     return true;
