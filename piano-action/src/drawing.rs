@@ -303,8 +303,13 @@ fn backcheck_part(action: &Action) -> Part {
     let k = &action.params.key;
     let mut part = Part::new("key-backcheck", Some("key"));
     let face = BackcheckFace::of(&action.params);
+    // The wire runs up into the head (drawn over it) from the key top.
     let foot = face.wire_foot();
-    part.wire(vec![foot, [foot[0], k.finger_mm[1]]], 1.2, METAL_FILL);
+    part.wire(
+        vec![[foot[0], foot[1] + 1.5], [foot[0], k.finger_mm[1]]],
+        1.2,
+        METAL_FILL,
+    );
     let [leather, block] = face.head();
     part.polygon(block, MOLDING_FILL);
     part.polygon(leather, BUCKSKIN_FILL);
@@ -451,8 +456,9 @@ fn lever_part(action: &Action) -> Part {
 /// parallel to the backcheck face as it stands at rest, so the tail is the moulding's
 /// lowest rear point, the catch face passes through it, and the backcheck (which stands
 /// behind that line at rest) never lies inside the head. Where the backcheck reaches up
-/// under the crown, the felt behind the moulding stops above the backcheck's top.
-fn hammer_part(params: &ActionParams, rest: &Transform) -> Part {
+/// under the crown (`with_backcheck`: the model has one), the felt behind the moulding
+/// stops above the backcheck's top.
+fn hammer_part(params: &ActionParams, rest: &Transform, with_backcheck: bool) -> Part {
     let h = &params.hammer;
     let mut part = Part::new("body-hammer", Some("hammer"));
     let to_rest = |q: P| map(rest, q);
@@ -494,7 +500,11 @@ fn hammer_part(params: &ActionParams, rest: &Transform) -> Part {
         .flatten()
         .map(|&q| to_body(q)[1])
         .fold(f64::NEG_INFINITY, f64::max);
-    let y_cut = (backcheck_top + HEAD_CLEARANCE).clamp(y_m, crown_c[1] + 0.9 * cr);
+    let y_cut = if with_backcheck {
+        (backcheck_top + HEAD_CLEARANCE).clamp(y_m, crown_c[1] + 0.9 * cr)
+    } else {
+        y_m
+    };
 
     // Butt: the wood round the centre pin, carrying the knuckle.
     part.polygon(
@@ -880,7 +890,7 @@ fn pendulum_parts(params: &ActionParams, shank_angle_rad: f64) -> Vec<Part> {
     );
     vec![
         flange,
-        hammer_part(params, &hammer_pose(params, shank_angle_rad)),
+        hammer_part(params, &hammer_pose(params, shank_angle_rad), false),
     ]
 }
 
@@ -1071,6 +1081,8 @@ fn draw_shape(svg: &mut Svg, s: &Shape) {
 /// it is pressed and where.
 struct ContactView {
     name: &'static str,
+    /// The name in the legend: the presser's pad is the finger's or the mass's.
+    label: &'static str,
     shapes: Vec<Shape>,
     active: bool,
     point: Option<P>,
@@ -1132,8 +1144,14 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
             }
             None => (Vec::new(), None),
         };
+        let label = match (name, action.presser) {
+            ("presser_key", Some(p)) if p.carried => "finger_key",
+            ("presser_key", Some(_)) => "mass_key",
+            _ => name,
+        };
         contacts.push(ContactView {
             name,
+            label,
             shapes,
             active: gap < 0.0,
             point,
@@ -1254,7 +1272,7 @@ fn frame_document(svg: Svg, contacts: &[ContactView], legend: &str, title: &str)
     let active: Vec<&str> = contacts
         .iter()
         .filter(|c| c.active)
-        .map(|c| c.name)
+        .map(|c| c.label)
         .collect();
     let list = if active.is_empty() {
         "none".to_string()
@@ -1405,7 +1423,8 @@ fn build_parts(action: &Action, rest: &BTreeMap<&'static str, Transform>) -> Vec
         parts.push(jack_part(action));
     }
     if let Some(x0) = rest.get("hammer") {
-        parts.push(hammer_part(&action.params, x0));
+        let with_backcheck = action.contacts.contains_key("backcheck");
+        parts.push(hammer_part(&action.params, x0, with_backcheck));
     }
     if action.contacts.contains_key("backcheck") {
         parts.push(backcheck_part(action));

@@ -390,6 +390,8 @@
     ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
     arrows.sort((p, q) => q.a.f - p.a.f);
     for (const { a, tip } of arrows) {
+      // An arrow whose head is off the canvas (zoomed elsewhere) is not named.
+      if (tip[0] < 0 || tip[0] > W || tip[1] < 0 || tip[1] > H) continue;
       const text = contactLabel(run, a.name) + ' ' + a.f.toFixed(a.f < 10 ? 2 : 1) + ' N';
       const box = placeLabel(ctx, text, tip, 6 * dpr, placed, W, H, dpr);
       drawLabel(ctx, text, box, tip, a.color, dpr, true);

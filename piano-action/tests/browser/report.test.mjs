@@ -39,13 +39,15 @@ try {
   const R = (fn, arg) => page.evaluate(fn, arg);
 
   // Play advances the clock by the chosen speed, paused it stands still. On Playwright's
-  // fake clock the page sees exactly the time we let pass, whatever the machine's load.
+  // fake clock, stopped (pauseAt) so that only runFor moves it, the page sees exactly the
+  // time we let pass, whatever the machine's load.
   {
     const timed = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
     timed.on('pageerror', (e) => errors.push(String(e)));
     await timed.clock.install({ time: 0 });
     await timed.goto(url);
     await timed.waitForFunction(() => window.pianoReport !== undefined);
+    await timed.clock.pauseAt(100000);
     const T = (fn, arg) => timed.evaluate(fn, arg);
     const playFor = async (speed, ms) => {
       await T((v) => { window.pianoReport.seek(0); window.pianoReport.setSpeed(v); window.pianoReport.play(); }, speed);
