@@ -64,7 +64,12 @@ pub struct Action {
     pub system: System,
     /// Element index of each contact, by name (`"capstan_heel"`, `"hammer_string"`, ...).
     pub contacts: BTreeMap<&'static str, usize>,
+    /// The presser over the key front (a weight or a finger), if it was built with one.
+    pub presser: Option<Presser>,
 }
+
+/// Radius of a [`Presser`]'s round pad (mm): its contact with the key top.
+pub const PRESSER_PAD_RADIUS_MM: f64 = 5.0;
 
 /// mm → m.
 fn m(v: [f64; 2]) -> [f64; 2] {
@@ -228,7 +233,6 @@ impl Action {
             ),
             BodySpec::new(h.mass_g * 1e-3, m(h.com_body_mm), h.inertia_com_kg_m2),
         );
-        const PAD_RADIUS_MM: f64 = 5.0;
         if let Some(pr) = presser {
             b.add_link(
                 "presser",
@@ -236,7 +240,7 @@ impl Action {
                 JointKind::Prismatic { axis: [0.0, 1.0] },
                 Placement::offset(
                     k.finger_mm[0] * 1e-3,
-                    (k.finger_mm[1] + PAD_RADIUS_MM + pr.height_mm) * 1e-3,
+                    (k.finger_mm[1] + PRESSER_PAD_RADIUS_MM + pr.height_mm) * 1e-3,
                 ),
                 BodySpec::new(pr.mass_kg, [0.0, 0.0], pr.mass_kg * 1e-4),
             );
@@ -535,7 +539,7 @@ impl Action {
                         m([kf[0] + 12.0, kf[1]]),
                     )?],
                 ),
-                ContactSide::on("presser", vec![circle([0.0, 0.0], PAD_RADIUS_MM)?]),
+                ContactSide::on("presser", vec![circle([0.0, 0.0], PRESSER_PAD_RADIUS_MM)?]),
                 &pr.pad,
                 &mut system,
             )?;
@@ -545,6 +549,7 @@ impl Action {
             params: params.clone(),
             system,
             contacts,
+            presser,
         })
     }
 

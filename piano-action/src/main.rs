@@ -153,8 +153,13 @@ fn simulate_scenario(
     if let InputSpec::Pendulum(piano_action::scenario::PendulumSpec { release_angle_deg }) =
         scenario.input
     {
-        let swing = piano_action::pendulum::swing(params, release_angle_deg, scenario.duration_s)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let swing = piano_action::pendulum::swing_sampled(
+            params,
+            release_angle_deg,
+            scenario.duration_s,
+            scenario.output_step_s,
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
         write_pendulum_dir(out, &scenario, params, &swing).map_err(|e| e.to_string())?;
         println!(
             "hammer swing: {} turning points in {} s",
@@ -163,7 +168,7 @@ fn simulate_scenario(
         );
         println!("run directory: {}", out.display());
         if report {
-            println!("(a pendulum run has no report: its summary.json has the swing)");
+            write_report(&[out.to_path_buf()], &out.join("report.html"), false)?;
         }
         return Ok(());
     }

@@ -27,6 +27,23 @@ pub struct Swing {
     pub com_distance_m: f64,
     /// Inertia about the flange pin (kg·m²).
     pub inertia_pin_kg_m2: f64,
+    /// Shank angle in the world when the hammer hangs at rest (rad): the angle from
+    /// hanging adds to it.
+    pub hanging_shank_angle_rad: f64,
+    /// Output times on a uniform grid from the release (s).
+    pub t: Vec<f64>,
+    /// Angle from hanging at each output time (rad).
+    pub angle_rad: Vec<f64>,
+    /// Angular velocity at each output time (rad/s).
+    pub rate_rad_s: Vec<f64>,
+}
+
+/// The shank's angle in the world when the hammer hangs at rest on its flange (rad): the
+/// centre of mass straight below the pin, i.e. the shank at −90° minus the centre of mass's
+/// angle above the shank.
+pub fn hanging_shank_angle_rad(params: &ActionParams) -> f64 {
+    let com = params.hammer.com_body_mm;
+    -std::f64::consts::FRAC_PI_2 - com[1].atan2(com[0])
 }
 
 /// Checks a release angle: non-zero and within ±170° of hanging.
@@ -43,17 +60,26 @@ pub fn check_release_angle(release_angle_deg: f64) -> Result<()> {
 }
 
 /// Releases the hammer at `release_angle_deg` from its hanging position and lets it swing
-/// for `duration_s`; the turning points are located as events.
+/// for `duration_s`; the turning points are located as events, the swing is sampled every
+/// millisecond (see [`swing_sampled`]).
 pub fn swing(params: &ActionParams, release_angle_deg: f64, duration_s: f64) -> Result<Swing> {
+    swing_sampled(params, release_angle_deg, duration_s, 1e-3)
+}
+
+/// [`swing`], sampled every `output_step_s`.
+pub fn swing_sampled(
+    params: &ActionParams,
+    release_angle_deg: f64,
+    duration_s: f64,
+    output_step_s: f64,
+) -> Result<Swing> {
     check_release_angle(release_angle_deg)?;
-    crate::simulate::check_duration(duration_s, 1e-3)?;
+    crate::simulate::check_duration(duration_s, output_step_s)?;
     let h = &params.hammer;
     let com = [h.com_body_mm[0] * 1e-3, h.com_body_mm[1] * 1e-3];
     let d = (com[0] * com[0] + com[1] * com[1]).sqrt();
     let mass = h.mass_g * 1e-3;
-    // Hanging: the centre of mass straight below the pin, i.e. the shank at −90° minus the
-    // centre of mass's angle above the shank.
-    let hanging = -std::f64::consts::FRAC_PI_2 - com[1].atan2(com[0]);
+    let hanging = hanging_shank_angle_rad(params);
     let mut b = ModelBuilder::new();
     b.gravity([0.0, -9.81]).add_link(
         "hammer",
@@ -70,7 +96,10 @@ pub fn swing(params: &ActionParams, release_angle_deg: f64, duration_s: f64) -> 
     );
     system.add_element(PivotFriction::new(&model, "hammer", friction)?.with_reversal_events())?;
     let x0 = system.initial_state(0.0, &[release_angle_deg.to_radians()], &[0.0])?;
-    let opts = Options::with_tolerances(1e-9, 1e-12);
+    let opts = Options {
+        output_step: Some(output_step_s),
+        ..Options::with_tolerances(1e-9, 1e-12)
+    };
     // The release itself is at rest: start just after it so it is not counted as a turn.
     let sol = solve_with_events(
         &mut MultibodyOde::new(&system),
@@ -95,5 +124,9 @@ pub fn swing(params: &ActionParams, release_angle_deg: f64, duration_s: f64) -> 
         turns,
         com_distance_m: d,
         inertia_pin_kg_m2: h.inertia_com_kg_m2 + mass * d * d,
+        hanging_shank_angle_rad: hanging,
+        angle_rad: (0..sol.len()).map(|i| sol.state(i)[0]).collect(),
+        rate_rad_s: (0..sol.len()).map(|i| sol.state(i)[1]).collect(),
+        t: sol.t,
     })
 }

@@ -1,6 +1,8 @@
 //! Static figures of a run for papers (`piano plot RUN_DIR --format svg|png`): hammer angle,
-//! hammer speed, key depth and the contact forces against time, with the let-off, string
-//! contact and key bottom marked. Drawn with plotters from the same data as the report.
+//! hammer speed, key depth and the contact forces against time (those the run has: a
+//! pendulum swing has only the hammer), with every strike, let-off, key bottom, check, drop,
+//! jack reset and turning point marked by a line and named, without overlap, at the top of
+//! the first panel. Drawn with plotters from the same data as the report.
 
 use std::path::Path;
 
@@ -105,25 +107,40 @@ fn times_ms(run: &Value) -> Vec<f64> {
         .unwrap_or_default()
 }
 
+/// The panels that apply to the run: hammer angle, hammer speed and key depth where the run
+/// has them, and the contact forces that carry load at some time (a pendulum has neither
+/// key nor contacts).
 fn panels(run: &Value) -> Vec<Panel> {
     let t = times_ms(run);
-    let series = |id: &str| -> Vec<(f64, f64)> {
-        run["series"]
+    let mut out = Vec::new();
+    for id in ["hammer_angle_deg", "hammer_speed_m_s", "key_depth_mm"] {
+        let Some(s) = run["series"]
             .as_array()
             .and_then(|all| all.iter().find(|s| s["id"] == id))
-            .and_then(|s| s["values"].as_array())
+        else {
+            continue;
+        };
+        let points: Points = s["values"]
+            .as_array()
             .map(|v| {
                 t.iter()
                     .copied()
                     .zip(v.iter().filter_map(Value::as_f64))
                     .collect()
             })
-            .unwrap_or_default()
-    };
-    let one = |title: &str, id: &str| Panel {
-        title: title.into(),
-        lines: vec![(String::new(), LINE_COLORS[0], series(id))],
-    };
+            .unwrap_or_default();
+        if points.is_empty() {
+            continue;
+        }
+        // The report's label, as a title: "hammer angle (°)" → "Hammer angle (deg)".
+        let label = s["label"].as_str().unwrap_or(id).replace("(°)", "(deg)");
+        let mut title = label[..1].to_uppercase();
+        title.push_str(&label[1..]);
+        out.push(Panel {
+            title,
+            lines: vec![(String::new(), LINE_COLORS[0], points)],
+        });
+    }
     // Contact forces: those that carry load at some time, largest peak first.
     let mut forces: Vec<(String, Points, f64)> = run["contacts"]
         .as_object()
@@ -140,18 +157,18 @@ fn panels(run: &Value) -> Vec<Panel> {
                         })
                         .unwrap_or_default();
                     let peak = f.iter().map(|p| p.1).fold(0.0, f64::max);
-                    (name.replace('_', " "), f, peak)
+                    let label = run["contact_labels"][name]
+                        .as_str()
+                        .map_or_else(|| name.replace('_', " "), str::to_string);
+                    (label, f, peak)
                 })
                 .filter(|c| c.2 > 0.0)
                 .collect()
         })
         .unwrap_or_default();
     forces.sort_by(|a, b| b.2.total_cmp(&a.2));
-    vec![
-        one("Hammer angle (deg)", "hammer_angle_deg"),
-        one("Hammer speed at the strike point (m/s)", "hammer_speed_m_s"),
-        one("Key-front depth below rest (mm)", "key_depth_mm"),
-        Panel {
+    if !forces.is_empty() {
+        out.push(Panel {
             title: "Contact forces (N)".into(),
             lines: forces
                 .into_iter()
@@ -159,8 +176,88 @@ fn panels(run: &Value) -> Vec<Panel> {
                 .enumerate()
                 .map(|(k, (name, f, _))| (name, LINE_COLORS[k], f))
                 .collect(),
-        },
-    ]
+        });
+    }
+    out
+}
+
+/// A marked moment: a vertical line in every panel, named at the top of the first.
+struct Mark {
+    /// Time (ms).
+    t: f64,
+    label: String,
+    color: RGBColor,
+}
+
+/// The moments marked on the figure: every strike (numbered, from the summary), and the
+/// listed let-offs, key bottoms, checks, drops, jack resets and turning points (see
+/// [`crate::report::listed_events`]), in time order.
+fn marks(run: &Value) -> Vec<Mark> {
+    let mut out: Vec<Mark> = run["summary"]["strikes"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|s| s["time_s"].as_f64())
+                .enumerate()
+                .map(|(k, t)| Mark {
+                    t: t * 1e3,
+                    label: format!("strike {}", k + 1),
+                    color: RGBColor(192, 57, 43),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    for e in run["listed_events"].as_array().into_iter().flatten() {
+        let (label, color) = match e["name"].as_str() {
+            Some("let_off") => ("let-off", RGBColor(22, 160, 133)),
+            Some("key_bottom") => ("key bottom", RGBColor(211, 84, 0)),
+            Some("check_catch") => ("check", RGBColor(183, 149, 11)),
+            Some("drop") => ("drop", RGBColor(52, 73, 94)),
+            Some("jack_reset") => ("jack reset", RGBColor(142, 68, 173)),
+            Some("turn") => ("turn", RGBColor(176, 58, 146)),
+            _ => continue,
+        };
+        if let Some(t) = e["time_s"].as_f64() {
+            out.push(Mark {
+                t: t * 1e3,
+                label: label.into(),
+                color,
+            });
+        }
+    }
+    out.sort_by(|a, b| a.t.total_cmp(&b.t));
+    out
+}
+
+/// Places the marks' labels in rows from the top of a plot whose time axis runs over the
+/// pixels `x` (left, right) from `t` (first, last, ms): each beside its line (right of it, or
+/// left when it would leave the plot), in the first row where it meets no other. Returns
+/// each label's left pixel and row.
+fn place_marks(marks: &[Mark], widths: &[f64], x: (f64, f64), t: (f64, f64)) -> Vec<(f64, usize)> {
+    const GAP: f64 = 4.0;
+    let mut rows: Vec<Vec<(f64, f64)>> = Vec::new();
+    marks
+        .iter()
+        .zip(widths)
+        .map(|(m, &w)| {
+            let px = x.0 + (m.t - t.0) / (t.1 - t.0) * (x.1 - x.0);
+            let left = if px + GAP + w <= x.1 {
+                px + GAP
+            } else {
+                px - GAP - w
+            };
+            let span = (left - GAP, left + w + GAP);
+            let row = rows
+                .iter()
+                .position(|r| r.iter().all(|&(a, b)| span.1 <= a || b <= span.0))
+                .unwrap_or(rows.len());
+            if row == rows.len() {
+                rows.push(Vec::new());
+            }
+            rows[row].push(span);
+            (left, row)
+        })
+        .collect()
 }
 
 /// Draws the figure on `root`.
@@ -180,29 +277,40 @@ fn draw<DB: DrawingBackend>(
             .unwrap_or(1.0)
             .max(t.first().copied().unwrap_or(0.0) + 1e-6),
     );
-    // Marked events: the first let-off, string contact and key bottom.
-    let marks: Vec<(f64, &str)> = ["let_off", "string_contact_start", "key_bottom"]
-        .into_iter()
-        .filter_map(|name| {
-            run["events"]
-                .as_array()?
-                .iter()
-                .find(|e| e["name"] == name)
-                .and_then(|e| e["time_s"].as_f64())
-                .map(|t| (t * 1e3, name))
+    let marks = marks(run);
+    let label_font: TextStyle = ("sans-serif", 14).into_font().into();
+    let widths: Vec<f64> = marks
+        .iter()
+        .map(|m| {
+            root.estimate_text_size(&m.label, &label_font)
+                .map(|(w, _)| f64::from(w))
+                .map_err(err)
         })
-        .collect();
-    for (area, panel) in root.split_evenly((2, 2)).iter().zip(panels(run)) {
+        .collect::<std::result::Result<_, _>>()?;
+    let panels = panels(run);
+    let cols = panels.len().clamp(1, 2);
+    let rows = panels.len().div_ceil(2).max(1);
+    for (k, (area, panel)) in root
+        .split_evenly((rows, cols))
+        .iter()
+        .zip(panels)
+        .enumerate()
+    {
         let values = panel.lines.iter().flat_map(|l| l.2.iter().map(|p| p.1));
         let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
             (a.min(v), b.max(v))
         });
-        let (lo, hi) = if lo.is_finite() && hi > lo {
+        let (lo, mut hi) = if lo.is_finite() && hi > lo {
             let pad = 0.06 * (hi - lo);
             (lo - pad, hi + pad)
         } else {
             (-1.0, 1.0)
         };
+        // The first panel keeps room at its top for the marks' names.
+        let named = k == 0 && !marks.is_empty();
+        if named {
+            hi += 0.3 * (hi - lo);
+        }
         let mut chart = ChartBuilder::on(area)
             .caption(&panel.title, ("sans-serif", 20))
             .margin(12)
@@ -217,13 +325,29 @@ fn draw<DB: DrawingBackend>(
             .light_line_style(RGBColor(238, 238, 238))
             .draw()
             .map_err(err)?;
-        for &(tm, _) in &marks {
+        for m in &marks {
+            // Strikes stand out: the blows are what the figure is about.
+            let width = if m.label.starts_with("strike") { 2 } else { 1 };
             chart
                 .draw_series(LineSeries::new(
-                    [(tm, lo), (tm, hi)],
-                    RGBColor(230, 160, 150).stroke_width(1),
+                    [(m.t, lo), (m.t, hi)],
+                    m.color.mix(0.55).stroke_width(width),
                 ))
                 .map_err(err)?;
+        }
+        if named {
+            let (x0, y0) = chart.backend_coord(&(t0, hi));
+            let (x1, _) = chart.backend_coord(&(t1, hi));
+            let base = area.get_base_pixel();
+            let places = place_marks(&marks, &widths, (f64::from(x0), f64::from(x1)), (t0, t1));
+            for (m, (left, row)) in marks.iter().zip(places) {
+                let at = (
+                    left.round() as i32 - base.0,
+                    y0 + 4 + 18 * row as i32 - base.1,
+                );
+                area.draw(&Text::new(m.label.clone(), at, label_font.color(&m.color)))
+                    .map_err(err)?;
+            }
         }
         let labelled = panel.lines.iter().any(|l| !l.0.is_empty());
         for (label, color, points) in &panel.lines {

@@ -107,6 +107,61 @@ fn describe(input: &InputSpec) -> String {
     }
 }
 
+/// Two onsets of the same contact closer than this are chatter, not a new event (s).
+pub const CHATTER_S: f64 = 0.005;
+
+/// The events of a run a reader should see, from the complete list of `events.json`
+/// (objects with `name` and `time_s`, in time order), in time order. Left out:
+/// - releases and lifts (`*_release`, `*_lift`): the end of what the onset started;
+/// - chatter: the same event again within [`CHATTER_S`] of its last occurrence;
+/// - a `let_off` before the jack has been reset (`jack_reset`) since the last one: the
+///   escaped jack's toe touching its button again is not a new let-off;
+/// - a `check_catch` with no string contact since the last one: the hammer bouncing on the
+///   backcheck is not a new check.
+///
+/// `events.json` itself stays complete.
+pub fn listed_events(events: &[Value]) -> Vec<Value> {
+    let mut out: Vec<Value> = Vec::new();
+    let (mut jack_out, mut struck_since_check, mut checked) = (false, false, false);
+    let mut last_seen = std::collections::BTreeMap::new();
+    for e in events {
+        let (Some(name), Some(t)) = (e["name"].as_str(), e["time_s"].as_f64()) else {
+            continue;
+        };
+        match name {
+            "jack_reset" => jack_out = false,
+            "string_contact_start" => struck_since_check = true,
+            _ => {}
+        }
+        if name.ends_with("_release") || name.ends_with("_lift") {
+            continue;
+        }
+        let before = last_seen.insert(name, t);
+        if before.is_some_and(|before| t - before <= CHATTER_S) {
+            continue;
+        }
+        match name {
+            "let_off" if jack_out => continue,
+            "let_off" => jack_out = true,
+            "check_catch" if checked && !struck_since_check => continue,
+            "check_catch" => (checked, struck_since_check) = (true, false),
+            _ => {}
+        }
+        out.push(e.clone());
+    }
+    out
+}
+
+/// How a contact is named for a reader: its name with spaces, and the presser's pad by
+/// what presses (a finger, or the dropped mass).
+fn contact_label(name: &str, input: &InputSpec) -> String {
+    match (name, input) {
+        ("presser_key", InputSpec::MassDrop(_)) => "mass on key".into(),
+        ("presser_key", _) => "finger on key".into(),
+        _ => name.replace('_', " "),
+    }
+}
+
 /// The report data of one run directory (see the module docs).
 pub fn run_data(dir: &Path) -> Result<Value> {
     let run = read_json(dir, "run.json")?;
@@ -117,11 +172,8 @@ pub fn run_data(dir: &Path) -> Result<Value> {
     params
         .validate()
         .map_err(|e| e.in_file(&dir.join("run.json")))?;
-    if matches!(scenario.input, InputSpec::Pendulum(PendulumSpec { .. })) {
-        return Err(bad(
-            dir,
-            "a pendulum run has no keystroke to replay (its summary.json has the swing)".into(),
-        ));
+    if let InputSpec::Pendulum(PendulumSpec { release_angle_deg }) = scenario.input {
+        return pendulum_data(dir, &params, release_angle_deg);
     }
     let kind: ModelKind = scenario.model_kind()?;
     let Prepared {
@@ -277,11 +329,16 @@ pub fn run_data(dir: &Path) -> Result<Value> {
             )
         })
         .collect();
+    let contact_labels: serde_json::Map<String, Value> = contact_names
+        .iter()
+        .map(|c| (c.to_string(), json!(contact_label(c, &scenario.input))))
+        .collect();
     let measured = read_measured(dir, &series)?;
     let series_json: Vec<Value> = series
         .into_iter()
         .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
         .collect();
+    let events = read_json(dir, "events.json")?;
     let name = dir
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
@@ -294,10 +351,98 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         "t": t,
         "carry": carry_json,
         "contacts": forces_json,
+        "contact_labels": contact_labels,
         "series": series_json,
-        "events": read_json(dir, "events.json")?,
+        "events": events,
+        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
         "summary": read_json(dir, "summary.json")?,
         "zoom": zoom,
+        "measured": measured,
+    }))
+}
+
+/// The report data of a pendulum run directory: the hammer hanging on its flange and
+/// swinging by the angle in `trajectory.csv`, the angle, the strike point's speed and the
+/// energies against time, the turning points as events. No key, no contacts.
+fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> Result<Value> {
+    let (header, rows) = read_trajectory(dir)?;
+    if header != ["time_s", "hammer_q", "hammer_v"] {
+        return Err(bad(
+            dir,
+            "trajectory.csv of a pendulum run has the columns time_s, hammer_q, hammer_v".into(),
+        ));
+    }
+    let h = &params.hammer;
+    let hanging = crate::pendulum::hanging_shank_angle_rad(params);
+    let mass = h.mass_g * 1e-3;
+    let com = h.com_body_mm[0].hypot(h.com_body_mm[1]) * 1e-3;
+    let inertia_pin = h.inertia_com_kg_m2 + mass * com * com;
+    let strike_radius_m = h.strike_body_mm[0].hypot(h.strike_body_mm[1]) * 1e-3;
+    let (mut t, mut carry) = (Vec::new(), [Vec::new(), Vec::new(), Vec::new()]);
+    let mut series: Vec<(&str, &str, Vec<f64>)> = vec![
+        (
+            "hammer_angle_deg",
+            "hammer angle from hanging (°)",
+            Vec::new(),
+        ),
+        (
+            "hammer_speed_m_s",
+            "hammer speed at the strike point (m/s)",
+            Vec::new(),
+        ),
+        ("kinetic_mj", "kinetic energy (mJ)", Vec::new()),
+        (
+            "gravity_mj",
+            "gravitational energy from the release (mJ)",
+            Vec::new(),
+        ),
+    ];
+    let q0 = rows[0][1];
+    for row in &rows {
+        let (time, q, w) = (row[0], row[1], row[2]);
+        t.push(r(time, 6));
+        for (slot, v) in carry
+            .iter_mut()
+            .zip(crate::drawing::pendulum_carry(params, q))
+        {
+            slot.push(r(v, 6));
+        }
+        // The centre of mass is d cos q below the pin.
+        let values = [
+            q.to_degrees(),
+            w * strike_radius_m,
+            0.5 * inertia_pin * w * w * 1e3,
+            mass * 9.81 * com * (q0.cos() - q.cos()) * 1e3,
+        ];
+        for (s, v) in series.iter_mut().zip(values) {
+            s.2.push(r(v, 4));
+        }
+    }
+    let events = read_json(dir, "events.json")?;
+    let measured = read_measured(dir, &series)?;
+    let series_json: Vec<Value> = series
+        .into_iter()
+        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
+        .collect();
+    let [a, x, y] = carry;
+    let name = dir
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string());
+    Ok(json!({
+        "name": name,
+        "title": format!("hammer swing, released {release_angle_deg}° from hanging"),
+        "model": "pendulum",
+        "scene": crate::drawing::pendulum_scene(params, hanging),
+        "t": t,
+        "carry": {"hammer": {"a": a, "x": x, "y": y}},
+        "contacts": {},
+        "contact_labels": {},
+        "series": series_json,
+        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
+        "events": events,
+        "summary": read_json(dir, "summary.json")?,
+        "zoom": {},
         "measured": measured,
     }))
 }

@@ -777,9 +777,13 @@ fn write_contacts_and_drawings(dir: &Path, prepared: &Prepared, run: &Run) -> Re
     Ok(())
 }
 
-/// Writes the run directory of a pendulum scenario: `run.json`, `events.json` (the turning
-/// points) and `summary.json` (no strikes; the turning points, the period and what the
-/// hammer's inertia and centre of mass predict for small swings).
+/// Writes the run directory of a pendulum scenario: `run.json`, `trajectory.csv` (time,
+/// the hammer's angle from hanging `hammer_q` in rad and its rate `hammer_v` in rad/s),
+/// `events.json` (the turning points), `summary.json` (no strikes; the turning points, the
+/// period and what the hammer's inertia and centre of mass predict for small swings) and
+/// the drawings `drawing_release.svg` and `drawing_turn.svg` (the hammer on its flange at
+/// the release and at the first turning point). There are no contacts, so no
+/// `contacts.csv`.
 pub fn write_pendulum_dir(
     dir: &Path,
     scenario: &Scenario,
@@ -787,6 +791,27 @@ pub fn write_pendulum_dir(
     swing: &crate::pendulum::Swing,
 ) -> Result<()> {
     start_run_dir(dir, scenario, params)?;
+    let mut csv = String::from("time_s,hammer_q,hammer_v\n");
+    for ((t, q), v) in swing.t.iter().zip(&swing.angle_rad).zip(&swing.rate_rad_s) {
+        let _ = writeln!(csv, "{t},{q},{v}");
+    }
+    write_file(dir, "trajectory.csv", &csv)?;
+    let shots = [
+        ("release", swing.angle_rad.first().map(|&q| (0.0, q))),
+        ("turn", swing.turns.first().map(|t| (t.time_s, t.angle_rad))),
+    ];
+    for (file, at) in shots {
+        if let Some((t, q)) = at {
+            let title = format!(
+                "hammer swing, {file} at t = {:.1} ms, {:.1}° from hanging",
+                t * 1e3,
+                q.to_degrees()
+            );
+            let svg =
+                crate::drawing::pendulum_svg(params, swing.hanging_shank_angle_rad + q, &title)?;
+            write_file(dir, &format!("drawing_{file}.svg"), &svg)?;
+        }
+    }
     let events: Vec<serde_json::Value> = swing
         .turns
         .iter()

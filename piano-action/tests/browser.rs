@@ -1,20 +1,90 @@
 //! A real report in headless Chromium (tests/browser/report.test.mjs, driven with
-//! playwright-core): no console error, no network request, Play moves the hammer, the
-//! scrubber, `#t=` and plot clicks seek, the string arrow shows at string contact.
+//! playwright-core): no console error, no network request, Play advances the clock (less at a
+//! slower speed) and moves the hammer, the scrubber, `#t=` and plot clicks seek, the string
+//! arrow shows at string contact, and no two labels on the 2D view overlap or leave it.
 //!
 //! Needs Node.js, Chromium (Debian's `chromium`) and `npm ci --prefix
-//! piano-action/tests/browser`, which `.ci/run` installs; there it is required
-//! (`PIANO_BROWSER_TESTS=required`). Elsewhere, without them, it says so and passes.
+//! piano-action/tests/browser`, which `.ci/run` installs. This test has its own `main`
+//! (`harness = false`) so that what it prints is not captured: when something is missing
+//! it says `SKIPPED` on the terminal of `cargo test`, and it fails instead when the
+//! environment asks for it (`PIANO_BROWSER_TESTS=required`, or `CI` set, as on CI
+//! services).
 
 use std::path::PathBuf;
-use std::process::Command;
+use std::process::{Command, ExitCode};
 
 use piano_action::ActionParams;
 use piano_action::report::write_report;
 use piano_action::scenario::{Scenario, write_run_dir};
 
-#[test]
-fn the_report_works_in_headless_chromium() {
+const NAME: &str = "the_report_works_in_headless_chromium";
+
+fn main() -> ExitCode {
+    if !selected(std::env::args().skip(1).collect()) {
+        return ExitCode::SUCCESS;
+    }
+    println!("\nrunning 1 test (browser)");
+    let outcome = run();
+    let (word, code) = match &outcome {
+        Outcome::Passed => ("ok", ExitCode::SUCCESS),
+        Outcome::Skipped(_) => ("SKIPPED", ExitCode::SUCCESS),
+        Outcome::Failed(_) => ("FAILED", ExitCode::FAILURE),
+    };
+    println!("test {NAME} ... {word}");
+    match outcome {
+        Outcome::Passed => {}
+        Outcome::Skipped(why) => println!(
+            "    SKIPPED: {why}\n    (see .ci/run: apt-get install chromium; npm ci --prefix \
+             piano-action/tests/browser; set PIANO_BROWSER_TESTS=required to make this a failure)"
+        ),
+        Outcome::Failed(why) => println!("\n{why}"),
+    }
+    println!();
+    code
+}
+
+/// Whether the command line (as `cargo test` passes it on to every test binary) selects
+/// this test: the libtest options that matter here are honoured (`FILTER`, `--exact`,
+/// `--skip PATTERN`, `--ignored`, `--list`), the others are ignored.
+fn selected(args: Vec<String>) -> bool {
+    let (mut filters, mut skips) = (Vec::new(), Vec::new());
+    let (mut exact, mut ignored_only) = (false, false);
+    let mut args = args.into_iter();
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--list" => {
+                println!("{NAME}: test");
+                return false;
+            }
+            "--exact" => exact = true,
+            "--ignored" => ignored_only = true,
+            "--skip" => skips.extend(args.next()),
+            "--test-threads" | "--format" | "--color" | "--logfile" | "-Z" | "--shuffle-seed" => {
+                args.next();
+            }
+            _ if a.starts_with('-') => {}
+            _ => filters.push(a),
+        }
+    }
+    let matches = |f: &String| {
+        if exact {
+            NAME == f
+        } else {
+            NAME.contains(f.as_str())
+        }
+    };
+    !ignored_only
+        && (filters.is_empty() || filters.iter().any(matches))
+        && !skips.iter().any(|s| NAME.contains(s.as_str()))
+}
+
+enum Outcome {
+    Passed,
+    Skipped(String),
+    Failed(String),
+}
+
+fn run() -> Outcome {
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/browser");
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
     let node_ok = Command::new("node").arg("--version").output().is_ok();
@@ -27,43 +97,63 @@ fn the_report_works_in_headless_chromium() {
     .flatten()
     .collect();
     if !missing.is_empty() {
-        let required = std::env::var("PIANO_BROWSER_TESTS").is_ok_and(|v| v == "required");
-        assert!(!required, "browser test required but {missing:?} missing");
-        eprintln!(
-            "SKIPPED: browser test needs {missing:?} (see .ci/run: apt-get install chromium; \
-             npm ci --prefix piano-action/tests/browser)"
-        );
-        return;
+        let required = std::env::var("PIANO_BROWSER_TESTS").is_ok_and(|v| v == "required")
+            || std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false");
+        let why = format!("the browser test needs {}", missing.join(", "));
+        return if required {
+            Outcome::Failed(format!(
+                "{why}, and it is required here (PIANO_BROWSER_TESTS=required or CI is set)"
+            ))
+        } else {
+            Outcome::Skipped(why)
+        };
     }
+    match checks(&here, &chromium) {
+        Ok(()) => Outcome::Passed,
+        Err(e) => Outcome::Failed(e),
+    }
+}
 
+fn checks(here: &std::path::Path, chromium: &str) -> Result<(), String> {
     let root = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("browser");
     let run = root.join("struck");
     let scenario = Scenario::from_toml_str(
         "model = \"double\"\nduration_s = 0.3\n[input]\nkind = \"touch\"\nstyle = \"struck\"\nfinger_speed_m_s = 1.2\n",
     )
-    .unwrap();
+    .map_err(|e| e.to_string())?;
     let params = ActionParams::reference();
-    let result = scenario.run(&params).unwrap();
+    let result = scenario.run(&params).map_err(|e| e.to_string())?;
     // The folder is kept between test runs: replace the last run and report.
-    piano_action::scenario::prepare_run_dir(&run, true).unwrap();
-    write_run_dir(&run, &scenario, &params, &result).unwrap();
+    piano_action::scenario::prepare_run_dir(&run, true).map_err(|e| e.to_string())?;
+    write_run_dir(&run, &scenario, &params, &result).map_err(|e| e.to_string())?;
     let report = root.join("report.html");
-    write_report(std::slice::from_ref(&run), &report, true).unwrap();
-    let strike = result.strikes[0].time_s;
+    write_report(std::slice::from_ref(&run), &report, true).map_err(|e| e.to_string())?;
+    let strike = result
+        .strikes
+        .first()
+        .ok_or("the struck touch does not strike")?;
     let shots = root.join("screenshots");
     let out = Command::new("node")
-        .current_dir(&here)
+        .current_dir(here)
         .arg("report.test.mjs")
         .arg(&report)
         .arg(&shots)
-        .arg(strike.to_string())
-        .env("CHROMIUM", &chromium)
+        .arg(strike.time_s.to_string())
+        .env("CHROMIUM", chromium)
         .output()
-        .unwrap();
+        .map_err(|e| format!("cannot run node: {e}"))?;
     let text = String::from_utf8_lossy(&out.stdout);
-    println!("{text}");
-    eprintln!("{}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "browser checks failed:\n{text}");
-    assert!(shots.join("02-string-contact.png").exists());
-    eprintln!("screenshots in {}", shots.display());
+    let errors = String::from_utf8_lossy(&out.stderr);
+    // What the browser saw, one check a line, and where the screenshots are.
+    for line in text.lines() {
+        println!("    {line}");
+    }
+    println!("    screenshots in {}", shots.display());
+    if !out.status.success() {
+        return Err(format!("browser checks failed:\n{text}\n{errors}"));
+    }
+    if !shots.join("02-string-contact.png").exists() {
+        return Err("no screenshot 02-string-contact.png".into());
+    }
+    Ok(())
 }

@@ -233,6 +233,84 @@ fn a_pendulum_scenario_writes_the_swing_and_its_period() {
 }
 
 #[test]
+fn the_pendulum_scenario_is_viewable_as_report_plot_and_drawings() {
+    let dir = std::env::temp_dir().join(format!("piano-swing-view-{}", std::process::id()));
+    let out = dir.join("run");
+    let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/pendulum.toml");
+    let (ok, _, err) = piano(&["simulate", scenario, "--out", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap();
+
+    // The trajectory: time, angle from hanging (rad), rate (rad/s), starting at the release.
+    let text = read("trajectory.csv");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("time_s,hammer_q,hammer_v"));
+    let rows: Vec<[f64; 3]> = lines
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    assert!(rows.len() > 2000, "{} rows", rows.len());
+    assert_eq!(rows[0][0], 0.0);
+    assert!(
+        (rows[0][1] - 30f64.to_radians()).abs() < 1e-12,
+        "{:?}",
+        rows[0]
+    );
+    assert_eq!(rows[0][2], 0.0);
+
+    // The turning points of events.json are the summary's, and the sampled swing turns
+    // there: no sample within 20 ms of one lies beyond its angle.
+    let events: serde_json::Value = serde_json::from_str(&read("events.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&read("summary.json")).unwrap();
+    let turns = summary["pendulum"]["turns"].as_array().unwrap();
+    let events = events.as_array().unwrap();
+    assert!(turns.len() >= 2 && events.len() == turns.len());
+    for (e, turn) in events.iter().zip(turns) {
+        assert_eq!(e["name"], "turn");
+        let t = e["time_s"].as_f64().unwrap();
+        assert_eq!(Some(t), turn["time_s"].as_f64());
+        let angle = turn["angle_deg"].as_f64().unwrap().to_radians();
+        let near: Vec<&[f64; 3]> = rows.iter().filter(|r| (r[0] - t).abs() <= 0.02).collect();
+        // A low turn (the swing came down to it) or a high one.
+        let low = rows.iter().find(|r| r[0] >= t - 0.05).unwrap()[1] > angle;
+        for r in near {
+            let beyond = if low { angle - r[1] } else { r[1] - angle };
+            assert!(beyond < 1e-6, "turn at {t} s, {angle} rad: sample {r:?}");
+        }
+    }
+
+    // Drawings: the hammer on its flange at the release and at the first turning point.
+    for name in ["drawing_release.svg", "drawing_turn.svg"] {
+        assert!(read(name).contains(r#"id="body-hammer""#), "{name}");
+    }
+
+    // The report and the figure work on it, and show the swing.
+    let (ok, stdout, err) = piano(&["report", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("report.html"), "{stdout}");
+    let html = read("report.html");
+    assert!(html.contains("hammer angle from hanging"));
+    let (ok, _, err) = piano(&["plot", out.to_str().unwrap()]);
+    if !ok {
+        // Without any font on the machine the error says how to give one.
+        assert!(err.contains("--font"), "{err}");
+    } else {
+        let figure = read("figure.svg");
+        assert!(figure.contains("Hammer angle from hanging (deg)"));
+        assert_eq!(
+            figure.matches(">\nturn\n<").count(),
+            turns.len(),
+            "a mark per turn"
+        );
+        // What a pendulum does not have is not plotted.
+        assert!(!figure.contains("Key-front depth") && !figure.contains("Contact forces"));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn simulate_runs_finger_touches_and_names_what_is_missing() {
     let dir = std::env::temp_dir().join(format!("piano-touch-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -193,3 +193,102 @@ fn measured_data_beside_a_run_are_embedded_for_overlay() {
     let e = report_html(std::slice::from_ref(&dir)).unwrap_err();
     assert!(e.to_string().contains("measured.csv, line 2"), "{e}");
 }
+
+/// Events as `events.json` has them, from `(name, time in ms)`.
+fn events(list: &[(&str, f64)]) -> Vec<serde_json::Value> {
+    list.iter()
+        .map(|(n, t)| serde_json::json!({"name": n, "time_s": t * 1e-3}))
+        .collect()
+}
+
+fn names(listed: &[serde_json::Value]) -> Vec<String> {
+    listed
+        .iter()
+        .map(|e| {
+            format!(
+                "{}@{}",
+                e["name"].as_str().unwrap(),
+                (e["time_s"].as_f64().unwrap() * 1e4).round() / 10.0
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_let_off_is_listed_once_per_escapement_and_a_check_once_per_blow() {
+    use piano_action::report::listed_events;
+    // The struck forte touch's events: after the check the escaped jack's toe touches its
+    // button again (41.5 and 51.3 ms) with no jack reset: chatter, not a let-off.
+    let struck = events(&[
+        ("finger_key", 0.4),
+        ("let_off", 21.2),
+        ("drop", 21.6),
+        ("string_contact_start", 22.6),
+        ("string_contact_end", 23.7),
+        ("drop_release", 23.9),
+        ("drop", 24.7),
+        ("let_off_release", 25.9),
+        ("check_catch", 27.8),
+        ("check_release", 30.0),
+        ("check_catch", 33.0),
+        ("let_off", 41.5),
+        ("let_off_release", 46.7),
+        ("let_off", 51.3),
+    ]);
+    assert_eq!(
+        names(&listed_events(&struck)),
+        [
+            "finger_key@0.4",
+            "let_off@21.2",
+            "drop@21.6",
+            "string_contact_start@22.6",
+            "string_contact_end@23.7",
+            "check_catch@27.8"
+        ]
+    );
+    // Repeated notes: once the jack is reset under the knuckle, the next let-off is a new
+    // one, and the check after the second blow is a new check.
+    let repeated = events(&[
+        ("let_off", 31.1),
+        ("string_contact_start", 31.5),
+        ("check_catch", 39.0),
+        ("let_off", 50.0),
+        ("check_release", 237.2),
+        ("jack_reset", 274.8),
+        ("let_off", 375.1),
+        ("string_contact_start", 378.2),
+        ("check_catch", 387.3),
+        ("let_off", 393.4),
+    ]);
+    assert_eq!(
+        names(&listed_events(&repeated)),
+        [
+            "let_off@31.1",
+            "string_contact_start@31.5",
+            "check_catch@39",
+            "jack_reset@274.8",
+            "let_off@375.1",
+            "string_contact_start@378.2",
+            "check_catch@387.3"
+        ]
+    );
+}
+
+#[test]
+fn the_page_lists_the_events_a_reader_should_see_and_keeps_them_all() {
+    let dir = run_dir("struck-events", STRUCK);
+    let data = embedded(&report_html(std::slice::from_ref(&dir)).unwrap());
+    let run = &data["runs"][0];
+    let all: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("events.json")).unwrap()).unwrap();
+    assert_eq!(run["events"], all, "events.json is embedded whole");
+    let listed = run["listed_events"].as_array().unwrap();
+    let count =
+        |list: &[serde_json::Value], name: &str| list.iter().filter(|e| e["name"] == name).count();
+    let all = all.as_array().unwrap();
+    assert!(count(all, "let_off") >= 1 && count(listed, "let_off") == 1);
+    assert_eq!(
+        count(listed, "string_contact_start"),
+        count(all, "string_contact_start")
+    );
+}

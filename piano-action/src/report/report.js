@@ -37,6 +37,8 @@
     return e;
   }
   const clamp = (x, a, b) => Math.min(b, Math.max(a, x));
+  // A contact's name for a reader (the presser's pad is a finger's or a mass's).
+  const contactLabel = (run, name) => (run.contact_labels || {})[name] || name.replace(/_/g, ' ');
   const fmtMs = (t) => (t * 1e3).toFixed(2) + ' ms';
 
   // Index i and weight u with t between run.t[i] and run.t[i + 1].
@@ -59,6 +61,11 @@
   el('h1', {}, header, RUNS.map((r) => r.title).join('  ·  '));
   const info = RUNS.map((r) => {
     const s = r.summary || {};
+    if (s.pendulum) {
+      const p = s.pendulum;
+      return r.name + ': ' + p.turns.length + ' turning points, period ' +
+        (p.period_s ? p.period_s.toFixed(3) + ' s' : '–') + ' (small swings: ' + p.small_amplitude_period_s.toFixed(3) + ' s)';
+    }
     const first = (s.strikes || [])[0];
     const v = first ? first.hammer_velocity_m_s.toFixed(2) + ' m/s at ' + fmtMs(first.time_s) : 'no strike';
     return r.name + ': ' + v;
@@ -97,22 +104,20 @@
   }, timeline);
   const marks = el('div', { id: 'event-marks' }, timeline);
   const eventList = el('div', { id: 'event-list' }, timeline);
-  // Events of all runs, in time order, each tagged with its run. The releases, and a
-  // contact chattering (the same event again within 5 ms), are left out unless asked for.
-  const allEvents = [];
-  RUNS.forEach((run, k) => (run.events || []).forEach((e) => allEvents.push({ name: e.name, t: e.time_s, run: k })));
-  allEvents.sort((a, b) => a.t - b.t);
-  const MINOR = /(_release|_lift)$/;
-  const keyEvents = allEvents.filter((e, k) => {
-    if (MINOR.test(e.name)) return false;
-    const prev = allEvents.slice(0, k).reverse().find((p) => p.run === e.run && p.name === e.name);
-    return !prev || e.t - prev.t > 0.005;
-  });
+  // Events of all runs, in time order, each tagged with its run. `piano report` lists the
+  // ones a reader should see (no releases, no chatter, no let-off again before the jack is
+  // reset, no second check without a new blow); ?all-events shows every one.
+  const tagged = (key) => {
+    const out = [];
+    RUNS.forEach((run, k) => (run[key] || []).forEach((e) => out.push({ name: e.name, t: e.time_s, run: k })));
+    return out.sort((a, b) => a.t - b.t);
+  };
+  const allEvents = tagged('events');
   const showAll = new URLSearchParams(location.search).has('all-events');
-  const events = showAll ? allEvents : keyEvents;
+  const events = showAll ? allEvents : tagged('listed_events');
   if (events.length < allEvents.length) {
     el('span', { class: 'legend' }, timeline,
-      (allEvents.length - events.length) + ' minor events (releases, chatter within 5 ms) not listed; open the page with ?all-events for all of them.');
+      (allEvents.length - events.length) + ' minor events (releases, chatter, the jack toe on its button again before the jack is reset, a second catch without a new blow) not listed; open the page with ?all-events for all of them.');
   }
   const eventButtons = events.map((e) => {
     const pos = (100 * (e.t - tStart)) / (tEnd - tStart || 1);
@@ -153,8 +158,9 @@
     const box = el('section', { class: 'view', id: 'view-' + k }, main);
     el('h2', {}, box, (RUNS.length > 1 ? '[' + (k + 1) + '] ' : '') + run.title + ' — 2D, to scale');
     const canvas = el('canvas', { id: 'canvas2d-' + k, 'aria-label': '2D view of ' + run.title }, box);
-    el('div', { class: 'note' }, box,
-      'Drag to pan, wheel to zoom. Red arrows: contact forces on the moving part (log scale, see legend).');
+    el('div', { class: 'note' }, box, 'Drag to pan, wheel to zoom.' + (Object.keys(run.contacts).length
+      ? ' Arrows: the contact forces on the moving part, one colour per contact, named beside them; length on a log scale (legend at the bottom left).'
+      : ''));
     const view = { run, canvas, box, bounds: sceneBounds(run.scene), center: null, halfWidth: null };
     fitZoom(view, 'whole action');
     let drag = null;
@@ -174,6 +180,52 @@
     }, { passive: false });
     return view;
   });
+
+  // Label placement on a canvas (device px). A label is a box [x0, y0, x1, y1]; `placed`
+  // holds the boxes already taken. Candidates go round the point `at` (right, left, above,
+  // below, at `gap`), then ever further above and below those; each is moved inside the
+  // canvas; the first that meets no placed box wins (the last resort is the freest place
+  // on a column at the canvas's right edge). The chosen box joins `placed`.
+  const overlap = (p, q) => p[0] < q[2] && q[0] < p[2] && p[1] < q[3] && q[1] < p[3];
+  function placeLabel(ctx, text, at, gap, placed, W, H, dpr) {
+    const w = ctx.measureText(text).width + 4 * dpr;
+    const h = parseFloat(ctx.font) * 1.25;
+    const fit = (x0, y0) => {
+      const x = clamp(x0, 1, W - w - 1), y = clamp(y0, 1, H - h - 1);
+      return [x, y, x + w, y + h];
+    };
+    const spots = [
+      [at[0] + gap, at[1] - h / 2], [at[0] - gap - w, at[1] - h / 2],
+      [at[0] - w / 2, at[1] - gap - h], [at[0] - w / 2, at[1] + gap],
+    ];
+    if (gap === 0) spots.unshift([at[0] - w / 2, at[1] - h / 2]);
+    const candidates = spots.map(([x, y]) => fit(x, y));
+    for (let k = 1; k * h < H; k++) {
+      for (const [x, y] of spots.slice(0, 2)) candidates.push(fit(x, y - k * h), fit(x, y + k * h));
+    }
+    for (let y = 1; y + h < H; y += h) candidates.push(fit(W - w - 1, y));
+    const box = candidates.find((b) => !placed.some((p) => overlap(p, b))) || candidates[0];
+    placed.push(box);
+    return box;
+  }
+  // Writes `text` in its box (on a white ground when `halo`); a thin line in `color` joins
+  // it to `from` (if given) when the box is not already there.
+  function drawLabel(ctx, text, box, from, color, dpr, halo) {
+    if (from) {
+      const near = [clamp(from[0], box[0], box[2]), clamp(from[1], box[1], box[3])];
+      if (Math.hypot(near[0] - from[0], near[1] - from[1]) > 3 * dpr) {
+        ctx.strokeStyle = color; ctx.lineWidth = 0.8 * dpr;
+        ctx.beginPath(); ctx.moveTo(from[0], from[1]); ctx.lineTo(near[0], near[1]); ctx.stroke();
+      }
+    }
+    if (halo) {
+      ctx.fillStyle = 'rgba(255,255,255,0.8)';
+      ctx.fillRect(box[0], box[1], box[2] - box[0], box[3] - box[1]);
+    }
+    ctx.fillStyle = color;
+    ctx.textAlign = 'left';
+    ctx.fillText(text, box[0] + 2 * dpr, (box[1] + box[3]) / 2);
+  }
 
   function fitZoom(view, name) {
     const z = (view.run.zoom || {})[name];
@@ -237,7 +289,10 @@
             pc.pts.forEach((p, k) => (k ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
             ctx.closePath();
             ctx.fillStyle = pc.fill; ctx.fill();
-            ctx.lineWidth = px; ctx.strokeStyle = '#333'; ctx.stroke();
+            // A part seen through the action (the bracket between keys): dashed.
+            if (part.behind) ctx.setLineDash([1.5, 1]);
+            ctx.lineWidth = px; ctx.strokeStyle = part.behind ? '#8c8c8c' : '#333'; ctx.stroke();
+            ctx.setLineDash([]);
           } else if (pc.kind === 'wire') {
             pc.pts.forEach((p, k) => (k ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
             ctx.lineWidth = pc.width; ctx.strokeStyle = pc.fill; ctx.stroke();
@@ -273,28 +328,47 @@
       if (!(c.f[k] > 0) || !(f > 0)) continue;
       active.push({ name, f, p: [c.px[k], c.py[k]], n: [c.nx[k], c.ny[k]], color: CONTACT_COLORS[name] || '#c0392b' });
     }
-    // Text in screen space.
+    // Text in screen space. Every label is placed where it overlaps no other and stays on
+    // the canvas (see placeLabel); what is written where is kept for tests.
     ctx.setTransform(1, 0, 0, 1, 0, 0);
-    ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
     ctx.textBaseline = 'middle';
-    // Part names, smaller when the whole action is in view.
-    ctx.font = ((view.halfWidth < 120 ? 11 : 9.5) * dpr) + 'px system-ui, sans-serif';
-    ctx.fillStyle = '#555';
-    for (const part of run.scene.parts) {
-      const [a, x, y] = part.frame ? carryAt(run, part.frame, i, u) : [0, 0, 0];
-      for (const l of part.labels) {
-        const q = [x + Math.cos(a) * l.anchor[0] - Math.sin(a) * l.anchor[1], y + Math.sin(a) * l.anchor[0] + Math.cos(a) * l.anchor[1]];
-        const sp = toScreen([q[0] + l.offset[0], q[1] + l.offset[1]]);
-        ctx.textAlign = l.align === 'middle' ? 'center' : l.align === 'end' ? 'right' : 'left';
-        ctx.fillText(l.text, sp[0], sp[1]);
-      }
-    }
+    const placed = [];
+    view.labels = [];
+    // Fixed texts first: the clock at the top left, scale bar and arrow legend at the bottom.
+    ctx.fillStyle = '#111';
+    ctx.font = (13 * dpr) + 'px system-ui, sans-serif';
+    ctx.textAlign = 'left';
+    const clock = 't = ' + fmtMs(state.t);
+    ctx.fillText(clock, 10 * dpr, 14 * dpr);
+    placed.push([6 * dpr, 4 * dpr, 14 * dpr + ctx.measureText(clock).width, 24 * dpr]);
     ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
+    const bar = [1, 2, 5, 10, 20, 50, 100].find((mm) => mm * s > 60 * dpr) || 100;
+    const bx = W - 16 * dpr - bar * s, by = H - 14 * dpr;
+    ctx.strokeStyle = '#000'; ctx.lineWidth = 1.5 * dpr;
+    ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + bar * s, by);
+    ctx.moveTo(bx, by - 4 * dpr); ctx.lineTo(bx, by + 4 * dpr);
+    ctx.moveTo(bx + bar * s, by - 4 * dpr); ctx.lineTo(bx + bar * s, by + 4 * dpr); ctx.stroke();
+    ctx.textAlign = 'center'; ctx.fillText(bar + ' mm', bx + (bar * s) / 2, by - 9 * dpr);
+    placed.push([bx - 4 * dpr, by - 17 * dpr, bx + bar * s + 4 * dpr, H]);
+    ctx.textAlign = 'left';
+    // Arrow legend: length only (the colour names the contact); none without contacts.
+    if (Object.keys(run.contacts).length) {
+      let lx = 10 * dpr;
+      const ly = H - 14 * dpr;
+      ctx.fillStyle = '#444'; ctx.strokeStyle = '#444'; ctx.lineWidth = 2 * dpr;
+      for (const f of [1, 10, 100]) {
+        const len = arrowPx(f, state.gain) * dpr;
+        ctx.beginPath(); ctx.moveTo(lx, ly); ctx.lineTo(lx + len, ly); ctx.stroke();
+        ctx.fillText(f + ' N', lx + len + 3 * dpr, ly);
+        lx += len + 40 * dpr;
+      }
+      placed.push([0, ly - 9 * dpr, lx, H]);
+    }
+
     // Force arrows on the moving part, log scaled in screen pixels so they read at any
     // zoom: 0.1 N, 1 N, 10 N and 100 N are equal steps (see the legend).
-    ctx.textAlign = 'left';
     view.arrowTips = {};
-    for (const a of active) {
+    const arrows = active.map((a) => {
       const L = arrowPx(a.f, state.gain) * dpr;
       const p0 = toScreen(a.p);
       const d = [a.n[0], -a.n[1]];
@@ -308,30 +382,39 @@
       ctx.lineTo(tip[0] + d[1] * w, tip[1] - d[0] * w);
       ctx.closePath(); ctx.fill();
       ctx.beginPath(); ctx.arc(p0[0], p0[1], 3 * dpr, 0, 2 * Math.PI); ctx.fill();
-      ctx.fillText(a.name.replace(/_/g, ' ') + ' ' + a.f.toFixed(a.f < 10 ? 2 : 1) + ' N', tip[0] + 6 * dpr, tip[1]);
       view.arrowTips[a.name] = [(p0[0] + tip[0]) / 2, (p0[1] + tip[1]) / 2];
-    }
-    // Time, scale bar, arrow legend.
-    ctx.fillStyle = '#111';
-    ctx.font = (13 * dpr) + 'px system-ui, sans-serif';
-    ctx.fillText('t = ' + fmtMs(state.t), 10 * dpr, 14 * dpr);
+      return { a, tip: [tip[0] + d[0] * h, tip[1] + d[1] * h] };
+    });
+    // Their labels, the largest force first: beside the arrow head if there is room, else
+    // the nearest free place, joined to the head by a thin line.
     ctx.font = (11 * dpr) + 'px system-ui, sans-serif';
-    const bar = [1, 2, 5, 10, 20, 50, 100].find((mm) => mm * s > 60 * dpr) || 100;
-    const bx = W - 16 * dpr - bar * s, by = H - 14 * dpr;
-    ctx.strokeStyle = '#000'; ctx.lineWidth = 1.5 * dpr;
-    ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + bar * s, by);
-    ctx.moveTo(bx, by - 4 * dpr); ctx.lineTo(bx, by + 4 * dpr);
-    ctx.moveTo(bx + bar * s, by - 4 * dpr); ctx.lineTo(bx + bar * s, by + 4 * dpr); ctx.stroke();
-    ctx.textAlign = 'center'; ctx.fillText(bar + ' mm', bx + (bar * s) / 2, by - 9 * dpr);
-    ctx.textAlign = 'left';
-    let lx = 10 * dpr;
-    const ly = H - 14 * dpr;
-    ctx.fillStyle = '#c0392b'; ctx.strokeStyle = '#c0392b'; ctx.lineWidth = 2 * dpr;
-    for (const f of [1, 10, 100]) {
-      const len = arrowPx(f, state.gain) * dpr;
-      ctx.beginPath(); ctx.moveTo(lx, ly); ctx.lineTo(lx + len, ly); ctx.stroke();
-      ctx.fillText(f + ' N', lx + len + 3 * dpr, ly);
-      lx += len + 40 * dpr;
+    arrows.sort((p, q) => q.a.f - p.a.f);
+    for (const { a, tip } of arrows) {
+      // An arrow whose head is off the canvas (zoomed elsewhere) is not named.
+      if (tip[0] < 0 || tip[0] > W || tip[1] < 0 || tip[1] > H) continue;
+      const text = contactLabel(run, a.name) + ' ' + a.f.toFixed(a.f < 10 ? 2 : 1) + ' N';
+      const box = placeLabel(ctx, text, tip, 6 * dpr, placed, W, H, dpr);
+      drawLabel(ctx, text, box, tip, a.color, dpr, true);
+      view.labels.push({ text, kind: 'force', box });
+    }
+    // Part names (smaller when the whole action is in view) where they do not hide a
+    // force label; a name whose part is off the canvas is not written.
+    ctx.font = ((view.halfWidth < 120 ? 11 : 9.5) * dpr) + 'px system-ui, sans-serif';
+    for (const part of run.scene.parts) {
+      const [a, x, y] = part.frame ? carryAt(run, part.frame, i, u) : [0, 0, 0];
+      for (const l of part.labels) {
+        const q = [x + Math.cos(a) * l.anchor[0] - Math.sin(a) * l.anchor[1], y + Math.sin(a) * l.anchor[0] + Math.cos(a) * l.anchor[1]];
+        const anchor = toScreen(q);
+        const at = toScreen([q[0] + l.offset[0], q[1] + l.offset[1]]);
+        if (at[0] < 0 || at[0] > W || at[1] < 0 || at[1] > H) continue;
+        const w = ctx.measureText(l.text).width;
+        const x0 = l.align === 'middle' ? at[0] - w / 2 : l.align === 'end' ? at[0] - w : at[0];
+        const box = placeLabel(ctx, l.text, [x0 + w / 2, at[1]], 0, placed, W, H, dpr);
+        const moved = Math.abs((box[0] + box[2]) / 2 - (x0 + w / 2)) > 1 || Math.abs((box[1] + box[3]) / 2 - at[1]) > 1;
+        const lead = moved || l.offset[0] !== 0 || l.offset[1] !== 0;
+        drawLabel(ctx, l.text, box, lead ? anchor : null, '#555', dpr);
+        view.labels.push({ text: l.text, kind: 'part', box });
+      }
     }
     view.canvas.dataset.activeContacts = active.map((a) => a.name).join(' ');
   }
@@ -342,7 +425,10 @@
   const THICKNESS = {
     'fixed-parts': 36, 'body-key': 22, 'body-wippen': 14, 'body-jack': 8,
     'body-repetition_lever': 10, 'body-hammer': 14, 'key-backcheck': 14, 'body-presser': 14,
+    'key-capstan': 8, 'action-bracket': 10,
   };
+  // A part seen through the action (the bracket, between keys) stands this far behind it.
+  const BEHIND_Z = -40;
   const hexColor = (h) => [1, 3, 5].map((k) => parseInt(h.slice(k, k + 2), 16) / 255);
 
   // Ear clipping of a simple polygon (any winding) into triangles of indices.
@@ -398,8 +484,8 @@
   }
 
   // Triangles (x, y, z, nx, ny, nz) of a polygon extruded from z = -h/2 to h/2.
-  function extrude(pts, h, out) {
-    const z0 = -h / 2, z1 = h / 2;
+  function extrude(pts, h, out, zc) {
+    const z0 = (zc || 0) - h / 2, z1 = (zc || 0) + h / 2;
     for (const [a, b, c] of triangulate(pts)) {
       for (const i of [a, b, c]) out.push(pts[i][0], pts[i][1], z1, 0, 0, 1);
       for (const i of [a, c, b]) out.push(pts[i][0], pts[i][1], z0, 0, 0, -1);
@@ -470,11 +556,12 @@
     const meshes = [];
     for (const part of run.scene.parts) {
       const h = THICKNESS[part.id] || 10;
+      const zc = part.behind ? BEHIND_Z : 0;
       for (const pc of part.pieces) {
         const data = [];
-        if (pc.kind === 'polygon') extrude(pc.pts, h, data);
-        else if (pc.kind === 'circle') extrude(circlePts(pc.c, pc.r, 28), h * 0.8, data);
-        else if (pc.kind === 'wire') extrude(wirePts(pc.pts, pc.width), Math.max(pc.width, 1.5), data);
+        if (pc.kind === 'polygon') extrude(pc.pts, h, data, zc);
+        else if (pc.kind === 'circle') extrude(circlePts(pc.c, pc.r, 28), h * 0.8, data, zc);
+        else if (pc.kind === 'wire') extrude(wirePts(pc.pts, pc.width), Math.max(pc.width, 1.5), data, zc);
         if (!data.length) continue;
         const buf = gl.createBuffer();
         gl.bindBuffer(gl.ARRAY_BUFFER, buf);
@@ -492,7 +579,8 @@
       color: gl.getUniformLocation(prog, 'color'), light: gl.getUniformLocation(prog, 'light'),
     };
     view.target = [(b.x0 + b.x1) / 2, (b.y0 + b.y1) / 2, 0];
-    view.distance = 1.3 * Math.max(b.x1 - b.x0, b.y1 - b.y0);
+    // Far enough back for the whole width, and for the whole height (a hanging hammer).
+    view.distance = Math.max(1.3 * (b.x1 - b.x0), 1.9 * (b.y1 - b.y0));
     view.azimuth = -0.42;
     view.elevation = 0.22;
     return true;
@@ -569,14 +657,20 @@
   const plotsBox = el('section', { id: 'plots' }, main);
   const plotDefs = [];
   const seriesOf = (run, id) => (run.series.find((s) => s.id === id) || {}).values;
-  plotDefs.push({ id: 'hammer-angle', title: 'Hammer angle (°)', lines: RUNS.map((r, k) => ({ run: k, id: 'hammer_angle_deg', label: r.name, values: seriesOf(r, 'hammer_angle_deg'), color: RUN_COLORS[k % 6] })) });
+  // A plot's title from its series' label in the first run that has it (a pendulum's
+  // hammer angle is from hanging).
+  const titleOf = (id, fallback) => {
+    const s = RUNS.map((r) => r.series.find((x) => x.id === id)).find((x) => x);
+    return s ? s.label.charAt(0).toUpperCase() + s.label.slice(1) : fallback;
+  };
+  plotDefs.push({ id: 'hammer-angle', title: titleOf('hammer_angle_deg', 'Hammer angle (°)'), lines: RUNS.map((r, k) => ({ run: k, id: 'hammer_angle_deg', label: r.name, values: seriesOf(r, 'hammer_angle_deg'), color: RUN_COLORS[k % 6] })) });
   plotDefs.push({ id: 'hammer-speed', title: 'Hammer speed at the strike point (m/s)', lines: RUNS.map((r, k) => ({ run: k, id: 'hammer_speed_m_s', label: r.name, values: seriesOf(r, 'hammer_speed_m_s'), color: RUN_COLORS[k % 6] })) });
   plotDefs.push({ id: 'key-depth', title: 'Key-front depth below rest (mm)', lines: RUNS.map((r, k) => ({ run: k, id: 'key_depth_mm', label: r.name, values: seriesOf(r, 'key_depth_mm'), color: RUN_COLORS[k % 6] })) });
   const forceLines = [];
   RUNS.forEach((r, k) => {
     for (const [name, c] of Object.entries(r.contacts)) {
       if (!c.f.some((f) => f > 0)) continue;
-      forceLines.push({ run: k, label: name.replace(/_/g, ' ') + (RUNS.length > 1 ? ' [' + (k + 1) + ']' : ''), values: c.f, color: CONTACT_COLORS[name] || '#333', dash: k ? [5, 3] : [] });
+      forceLines.push({ run: k, label: contactLabel(r, name) + (RUNS.length > 1 ? ' [' + (k + 1) + ']' : ''), values: c.f, color: CONTACT_COLORS[name] || '#333', dash: k ? [5, 3] : [] });
     }
   });
   plotDefs.push({ id: 'contact-forces', title: 'Contact forces (N)', lines: forceLines });
@@ -587,7 +681,8 @@
   if (RUNS.some((r) => seriesOf(r, 'key_drive_force_n'))) {
     plotDefs.push({ id: 'hand-force', title: 'Hand force at the key front (N)', lines: RUNS.map((r, k) => ({ run: k, id: 'key_drive_force_n', label: r.name, values: seriesOf(r, 'key_drive_force_n'), color: RUN_COLORS[k % 6] })).filter((l) => l.values) });
   }
-  const plots = plotDefs.map((def) => {
+  // Plots of quantities no run has (a pendulum has no key, no contacts) are left out.
+  const plots = plotDefs.filter((def) => def.lines.some((l) => l.values && l.values.length)).map((def) => {
     const box = el('div', { class: 'plot', id: 'plot-' + def.id }, plotsBox);
     el('h3', {}, box, def.title);
     const canvas = el('canvas', { id: 'plotcanvas-' + def.id }, box);
@@ -788,6 +883,11 @@
     frameTime: (i, k) => RUNS[k || 0].t[i],
     angleAtFrame: (i, k) => seriesOf(RUNS[k || 0], 'hammer_angle_deg')[i],
     webgl: (k) => !!views3d[k || 0].gl,
+    // Every text written on the 2D view now: its words, 'force' or 'part', and its box
+    // [x0, y0, x1, y1] in canvas pixels; and the canvas size in the same pixels.
+    labels: (k) => (views[k || 0].labels || []).map((l) => ({ text: l.text, kind: l.kind, box: l.box.slice() })),
+    canvasSize: (k) => [views[k || 0].canvas.width, views[k || 0].canvas.height],
+    plots: () => plots.map((p) => p.def.id),
   };
 
   draw();
