@@ -1411,3 +1411,117 @@ fn rest_rail(p: &ActionParams, s: &Shapes, r: &mut Report) {
         );
     }
 }
+
+#[cfg(test)]
+mod drift {
+    //! The checker keeps its own plane copy of the contact shapes: these tests hold it to
+    //! the shapes `Action::build` makes, so the two cannot drift apart unseen.
+    use super::*;
+    use crate::{Action, ModelKind};
+
+    /// The checker's gap of each contact at `pose` (mm).
+    fn checker_gaps(p: &ActionParams, pose: Pose) -> Vec<(&'static str, f64)> {
+        let s = Shapes::new(p);
+        let g = &p.regulation;
+        let on_ground = |y, x, up, (c, r): (V, f64)| ground(y, x, up).gap(c, r);
+        vec![
+            (
+                "front_rail",
+                on_ground(
+                    g.front_rail_top_y_mm,
+                    g.front_rail_x_mm,
+                    true,
+                    s.front_pad(pose),
+                ),
+            ),
+            (
+                "back_rail",
+                on_ground(
+                    g.back_rail_top_y_mm,
+                    g.back_rail_x_mm,
+                    true,
+                    s.back_pad(pose),
+                ),
+            ),
+            ("capstan_heel", {
+                let (c, r) = s.capstan(pose);
+                s.heel(pose).gap(c, r)
+            }),
+            ("jack_knuckle", {
+                let (c, r) = s.knuckle(pose);
+                s.jack_top(pose).gap(c, r)
+            }),
+            ("lever_knuckle", {
+                let (c, r) = s.knuckle(pose);
+                s.lever_top(pose).gap(c, r)
+            }),
+            (
+                "let_off_button",
+                on_ground(
+                    g.let_off_button_y_mm,
+                    g.let_off_button_x_mm,
+                    false,
+                    s.toe(pose),
+                ),
+            ),
+            (
+                "drop_screw",
+                on_ground(g.drop_screw_y_mm, g.drop_screw_x_mm, false, s.tip(pose)),
+            ),
+            ("backcheck", {
+                let (c, r) = s.tail(pose);
+                s.backcheck(pose).gap(c, r)
+            }),
+            (
+                "rest_rail",
+                on_ground(g.rest_rail_top_y_mm, g.rest_rail_x_mm, true, s.shank(pose)),
+            ),
+            (
+                "hammer_string",
+                on_ground(g.string_y_mm, g.string_x_mm, false, s.crown(pose)),
+            ),
+        ]
+    }
+
+    fn compare(p: &ActionParams, pose: Pose) {
+        let action = Action::build(p, ModelKind::Double).unwrap();
+        let model = action.system.model().clone();
+        let mut x = action.layout_state().unwrap();
+        for (name, q) in [
+            ("key", pose.key),
+            ("wippen", pose.wippen),
+            ("hammer", pose.hammer),
+        ] {
+            x[model.coordinate_id(name).unwrap()] = q;
+        }
+        for (name, ours) in checker_gaps(p, pose) {
+            let built = action.gap(name, 0.0, &x).unwrap() * 1e3;
+            // 1 µm: the checker's thresholds are millimetres; it normalises the file's jack
+            // axis (length 1.0005), which moves the turned jack top by some 0.03 µm.
+            assert!(
+                (ours - built).abs() < 1e-3,
+                "{name} at {pose:?}: checker {ours} mm, action {built} mm"
+            );
+        }
+    }
+
+    #[test]
+    fn the_checker_sees_the_gaps_the_built_action_has() {
+        let reference = ActionParams::reference();
+        for pose in [
+            Pose::default(),
+            Pose {
+                key: -0.02,
+                wippen: 0.03,
+                hammer: 0.2,
+            },
+        ] {
+            compare(&reference, pose);
+            let mut p = reference.clone();
+            p.regulation.capstan_raise_mm = 1.5;
+            p.regulation.backcheck_offset_mm = -1.0;
+            p.regulation.string_y_mm += 3.0;
+            compare(&p, pose);
+        }
+    }
+}
