@@ -1,18 +1,7 @@
 //! The `piano` command as a user runs it.
 
-use std::process::Command;
-
-fn piano(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_piano"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::piano;
 
 #[test]
 fn params_writes_the_default_file_and_params_loads_it_back() {

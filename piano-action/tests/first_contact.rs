@@ -4,19 +4,9 @@
 //! the field.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn piano(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_piano"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::piano;
 
 /// A fresh folder for one test.
 fn folder(name: &str) -> PathBuf {
