@@ -193,6 +193,30 @@ fn simulate_scenario(
     Ok(())
 }
 
+/// Runs `work`, showing a spinner with `what` on standard error if it takes more than a
+/// second (and standard error is a terminal).
+fn with_spinner<T>(what: &str, work: impl FnOnce() -> T) -> T {
+    let (done, wait) = std::sync::mpsc::channel::<()>();
+    let what = what.to_string();
+    let spinner = std::thread::spawn(move || {
+        if wait.recv_timeout(std::time::Duration::from_secs(1)).is_ok() {
+            return;
+        }
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.set_message(what);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg}, {elapsed}") {
+            bar.set_style(style);
+        }
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        let _ = wait.recv();
+        bar.finish_and_clear();
+    });
+    let out = work();
+    let _ = done.send(());
+    let _ = spinner.join();
+    out
+}
+
 /// A progress bar for one simulation, on standard error: drawn only on a terminal, and only
 /// once the run has taken more than a second (a keystroke takes milliseconds).
 struct Progress {
@@ -365,8 +389,11 @@ fn model_kind(name: &str) -> Result<ModelKind, String> {
 }
 
 fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), String> {
-    let w = piano_action::touchweight::measure(params, model_kind(model)?)
-        .map_err(|e| e.to_string())?;
+    let kind = model_kind(model)?;
+    let w = with_spinner("measuring the touchweight", || {
+        piano_action::touchweight::measure(params, kind)
+    })
+    .map_err(|e| e.to_string())?;
     if json {
         let v = serde_json::json!({
             "down_weight_gf": w.down_weight_gf,
@@ -403,7 +430,8 @@ fn regulate(
             path.display()
         ));
     }
-    let done = regulate(params, kind, &Targets::default()).map_err(|e| e.to_string())?;
+    let done = with_spinner("regulating", || regulate(params, kind, &Targets::default()))
+        .map_err(|e| e.to_string())?;
     let r = &done.achieved;
     let g = &done.params.regulation;
     if json {
