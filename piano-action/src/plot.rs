@@ -314,6 +314,8 @@ fn draw<DB: DrawingBackend>(
         let mut chart = ChartBuilder::on(area)
             .caption(&panel.title, ("sans-serif", 20))
             .margin(12)
+            // Room on the right for the last time label, centred on the axis end.
+            .margin_right(28)
             .x_label_area_size(36)
             .y_label_area_size(56)
             .build_cartesian_2d(t0..t1, lo..hi)
