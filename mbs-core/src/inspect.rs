@@ -62,12 +62,19 @@ impl StatesFile {
         let de = &mut serde_json::Deserializer::from_str(text);
         let file: StatesFile = serde_path_to_error::deserialize(de).map_err(|e| {
             let inner = e.inner();
+            // serde_json ends its message with the place, which is said first here.
+            let message = inner.to_string();
+            let message = message
+                .rsplit_once(" at line ")
+                .map_or(message.as_str(), |(m, _)| m);
+            let field = match e.path().to_string() {
+                p if p == "." => String::new(),
+                p => format!(", field `{p}`"),
+            };
             CoreError::States(format!(
-                "line {}, column {}, field `{}`: {}",
+                "line {}, column {}{field}: {message}",
                 inner.line(),
                 inner.column(),
-                e.path(),
-                inner
             ))
         })?;
         if file.states.is_empty() {

@@ -694,6 +694,19 @@ fn chain(p: &ActionParams, s: &Shapes, r: &mut Report) -> Option<Chain> {
             ),
         );
     }
+    // The wippen hangs from the action's rail above the key, its heel on the capstan.
+    let key_top = k.finger_mm[1];
+    if w.pivot_mm[1] < key_top + m {
+        r.push(
+            "wippen.pivot_mm",
+            format!(
+                "the wippen's flange pin (y = {} mm) is not above the key, whose top is at y = \
+                 {key_top} mm: the wippen hangs from the action rail over the key, its heel \
+                 resting on the capstan; raise wippen.pivot_mm",
+                w.pivot_mm[1]
+            ),
+        );
+    }
     let (capstan, _) = s.capstan(Pose::default());
     let finger_arm = kx - k.finger_mm[0];
     if capstan[0] < kx + m {

@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
-use piano_action::{ActionParams, Finger, Input, ModelKind, TouchStyle, simulate};
+use piano_action::{ActionParams, Finger, Input, ModelKind, PianoError, TouchStyle, simulate};
 
 /// Grand piano action simulator.
 #[derive(Parser)]
@@ -115,14 +115,40 @@ fn plot(
 ) -> Result<(), String> {
     let fmt = piano_action::plot::Format::parse(format).map_err(|e| e.to_string())?;
     let path = out.unwrap_or_else(|| run.join(format!("figure.{format}")));
-    if path.exists() && !force {
-        return Err(format!(
-            "{}: exists; choose another --out, or pass --force to replace it",
-            path.display()
-        ));
-    }
+    check_out_file(&path, format, force)?;
     piano_action::plot::plot_run(run, fmt, &path, font).map_err(|e| e.to_string())?;
     println!("figure: {}", path.display());
+    Ok(())
+}
+
+/// Checks a file a command is about to write: named `*.EXTENSION`, in a folder that exists,
+/// not a folder itself, and not replacing a file unless `force` is set.
+fn check_out_file(out: &std::path::Path, extension: &str, force: bool) -> Result<(), String> {
+    let flag_error = |why: String| format!("option --out: {}: {why}", out.display());
+    if out.extension().and_then(|e| e.to_str()) != Some(extension) {
+        return Err(flag_error(format!(
+            "this command writes {}, so the file must end in .{extension}",
+            extension.to_uppercase()
+        )));
+    }
+    if out.is_dir() {
+        return Err(flag_error("is a folder; name a file".into()));
+    }
+    if let Some(parent) = out.parent()
+        && !parent.as_os_str().is_empty()
+        && !parent.is_dir()
+    {
+        return Err(flag_error(format!(
+            "the folder {} does not exist",
+            parent.display()
+        )));
+    }
+    if out.exists() && !force {
+        return Err(format!(
+            "{}: exists; choose another --out, or pass --force to replace it",
+            out.display()
+        ));
+    }
     Ok(())
 }
 
@@ -145,11 +171,12 @@ fn simulate_scenario(
     force: bool,
 ) -> Result<(), String> {
     use piano_action::scenario::{
-        InputSpec, Scenario, prepare_run_dir, write_pendulum_dir, write_run_dir,
+        InputSpec, Scenario, check_run_dir, prepare_run_dir, write_pendulum_dir, write_run_dir,
     };
     let scenario = Scenario::load(path).map_err(|e| e.to_string())?;
-    // Refuse (or clear) an earlier run before spending time on this one.
-    prepare_run_dir(out, force).map_err(|e| e.to_string())?;
+    // Refuse an earlier run before spending time on this one; replace it (with --force)
+    // only once the new run has succeeded.
+    check_run_dir(out, force).map_err(|e| e.to_string())?;
     if let InputSpec::Pendulum(piano_action::scenario::PendulumSpec { release_angle_deg }) =
         scenario.input
     {
@@ -160,6 +187,7 @@ fn simulate_scenario(
             scenario.output_step_s,
         )
         .map_err(|e| format!("{}: {e}", path.display()))?;
+        prepare_run_dir(out, force).map_err(|e| e.to_string())?;
         write_pendulum_dir(out, &scenario, params, &swing).map_err(|e| e.to_string())?;
         println!(
             "hammer swing: {} turning points in {} s",
@@ -175,12 +203,17 @@ fn simulate_scenario(
     let mut progress = Progress::new(scenario.duration_s);
     let run = scenario
         .run_observed(params, &mut |t| progress.update(t))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| match e {
+            PianoError::Simulation(_) => format!("{}: {e}", path.display()),
+            e => e.to_string(),
+        });
     progress.finish();
+    let run = run?;
+    prepare_run_dir(out, force).map_err(|e| e.to_string())?;
     write_run_dir(out, &scenario, params, &run).map_err(|e| e.to_string())?;
     for s in &run.strikes {
         println!(
-            "strike at {:.1} ms, hammer {:.2} m/s, contact {}",
+            "strike at {:.1} ms, hammer {:.2} m/s, contact {} ms",
             s.time_s * 1e3,
             s.hammer_velocity_m_s,
             ms(s.contact_duration_s)
@@ -275,7 +308,7 @@ struct SweepArgs {
     #[arg(long, allow_negative_numbers = true)]
     to: Option<f64>,
     /// Number of runs.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, allow_negative_numbers = true)]
     runs: usize,
     /// Space the levels evenly rather than on a log scale.
     #[arg(long)]
@@ -286,8 +319,8 @@ struct SweepArgs {
     /// Simulated time per run (s).
     #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     duration: f64,
-    /// Worker threads (default: one per core).
-    #[arg(long)]
+    /// Worker threads (default: one per core; at most 256).
+    #[arg(long, allow_negative_numbers = true)]
     jobs: Option<usize>,
     /// The CSV file to write (refuses to overwrite a file).
     #[arg(long)]
@@ -305,7 +338,7 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
         "struck" => SweepKind::Struck,
         other => {
             return Err(format!(
-                "--touch: unknown '{other}' (force, pressed or struck)"
+                "option --touch: unknown '{other}' (force, pressed or struck)"
             ));
         }
     };
@@ -321,17 +354,17 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
             e.as_input().map_or(e.to_string(), |i| i.message.clone())
         )
     })?;
-    if a.jobs == Some(0) {
-        return Err("option --jobs: needs at least one worker thread".into());
-    }
-    if a.out.exists() && !a.force {
+    if let Some(jobs) = a.jobs
+        && !(1..=256).contains(&jobs)
+    {
         return Err(format!(
-            "{}: exists; choose another --out, or pass --force to replace it",
-            a.out.display()
+            "option --jobs: must be 1 to 256 worker threads, got {jobs}"
         ));
     }
+    check_out_file(&a.out, "csv", a.force)?;
     let values = levels(a.from.unwrap_or(lo), a.to.unwrap_or(hi), a.runs, !a.linear)
         .map_err(|e| e.to_string())?;
+    piano_action::sweep::check_levels(kind, &values).map_err(|e| e.to_string())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.jobs.unwrap_or(0))
         .build()
@@ -348,7 +381,7 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
     bar.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     std::fs::write(&a.out, csv(kind, &rows))
-        .map_err(|e| format!("cannot write {}: {e}", a.out.display()))?;
+        .map_err(|e| format!("{}: cannot write: {e}", a.out.display()))?;
     let speeds: Vec<f64> = rows
         .iter()
         .filter_map(|r| r.run.as_ref().ok())
@@ -376,6 +409,12 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
         println!("{failed} runs failed: see the error column");
     }
     println!("wrote {}", a.out.display());
+    if failed == rows.len() {
+        return Err(format!(
+            "all {failed} runs failed: see the error column of {}",
+            a.out.display()
+        ));
+    }
     Ok(())
 }
 
@@ -426,7 +465,7 @@ fn regulate(
         && path.exists()
     {
         return Err(format!(
-            "{} exists; choose a new file for the regulated parameters",
+            "{}: exists; choose a new file for the regulated parameters (option --write)",
             path.display()
         ));
     }
@@ -613,8 +652,19 @@ fn demo_report(params: &ActionParams) -> Result<(), String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result =
-        load(cli.params.as_deref()).and_then(|params| match cli.command.unwrap_or(Command::Demo) {
+    let command = cli.command.unwrap_or(Command::Demo);
+    // `plot`, `report` and `params` use no parameter file: say so rather than ignore one.
+    let unused = match &command {
+        Command::Plot { .. } => Some("plot (the run directory holds its parameters)"),
+        Command::Report { .. } => Some("report (the run directories hold their parameters)"),
+        Command::Params => Some("params (it writes the default file)"),
+        _ => None,
+    };
+    let result = match (unused, cli.params.as_deref()) {
+        (Some(what), Some(_)) => Err(format!(
+            "option --params: not used by `piano {what}`; leave it out"
+        )),
+        _ => load(cli.params.as_deref()).and_then(|params| match command {
             Command::Demo => demo(&params),
             Command::Touchweight { model, json } => touchweight(&params, &model, json),
             Command::Regulate { model, json, write } => {
@@ -644,7 +694,8 @@ fn main() -> ExitCode {
                     .write_all(piano_action::params::DEFAULT_PARAMS_TOML.as_bytes());
                 Ok(())
             }
-        });
+        }),
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

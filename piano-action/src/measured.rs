@@ -30,6 +30,8 @@ pub fn parse_measured(text: &str, file: &Path, known: &[&str]) -> Result<Vec<Ser
             .in_file(file)
             .at_line((line > 0).then_some(line))
     };
+    // A spreadsheet's UTF-8 byte-order mark is not part of the first header.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -146,6 +148,12 @@ mod tests {
         assert_eq!(s[0].t, vec![0.0, 0.001]);
         assert_eq!(s[1].t, vec![0.001]);
         assert_eq!(s[1].v, vec![1.0]);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_not_part_of_the_header() {
+        let s = parse("\u{feff}time_s,key_depth_mm\r\n0,0.5\r\n").unwrap();
+        assert_eq!(s[0].v, vec![0.5]);
     }
 
     #[test]

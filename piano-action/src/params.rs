@@ -410,6 +410,23 @@ impl ActionParams {
             ),
         ];
         self.contacts.check()?;
+        // Beyond 10 % per step the integrator's error control means nothing [D].
+        if self.numerics.relative_tolerance > 0.1 {
+            return Err(PianoError::params(
+                "numerics.relative_tolerance",
+                format!(
+                    "must be at most 0.1 (the default is 1e-3), got {}",
+                    self.numerics.relative_tolerance
+                ),
+            ));
+        }
+        // Four samples per step see every event of the tests; 64 is plenty [D].
+        if self.numerics.event_samples > 64 {
+            return Err(PianoError::params(
+                "numerics.event_samples",
+                format!("must be at most 64, got {}", self.numerics.event_samples),
+            ));
+        }
         if self.numerics.event_samples == 0 {
             return Err(PianoError::params(
                 "numerics.event_samples",
@@ -448,10 +465,23 @@ fn check_table(prefix: &str, table: &toml::Table) -> Result<()> {
 }
 
 fn check_value(path: &str, v: &toml::Value) -> Result<()> {
+    let name = path.rsplit('.').next().unwrap_or(path);
+    // Frictions, stiffnesses and dampings resist motion; a negative one would feed it.
+    let non_negative =
+        name.ends_with("friction_n_m") || name.contains("stiffness") || name.contains("damping");
+    let positive = name.contains("regularization");
     match v {
         toml::Value::Float(x) if !x.is_finite() => {
             Err(PianoError::params(path, format!("must be finite, got {x}")))
         }
+        toml::Value::Float(x) if non_negative && *x < 0.0 => Err(PianoError::params(
+            path,
+            format!("must not be negative (it resists motion), got {x}"),
+        )),
+        toml::Value::Float(x) if positive && *x <= 0.0 => Err(PianoError::params(
+            path,
+            format!("must be positive, got {x}"),
+        )),
         toml::Value::Table(t) => check_table(path, t),
         toml::Value::Array(a) => {
             for (i, x) in a.iter().enumerate() {

@@ -46,15 +46,15 @@ pub fn hanging_shank_angle_rad(params: &ActionParams) -> f64 {
     -std::f64::consts::FRAC_PI_2 - com[1].atan2(com[0])
 }
 
-/// Checks a release angle: non-zero and within ±170° of hanging.
+/// Checks a release angle: 0.5° to 170° either side of hanging [D: below 0.5° the swing is
+/// lost in the flange friction's dead band; past 170° the hammer would start upside down].
 pub fn check_release_angle(release_angle_deg: f64) -> Result<()> {
-    if release_angle_deg.is_finite() && release_angle_deg.abs() < 170.0 && release_angle_deg != 0.0
-    {
+    if release_angle_deg.is_finite() && (0.5..=170.0).contains(&release_angle_deg.abs()) {
         Ok(())
     } else {
         Err(PianoError::scenario(
             "input.release_angle_deg",
-            format!("must be non-zero and within ±170°, got {release_angle_deg}"),
+            format!("must be 0.5° to 170° either side of hanging, got {release_angle_deg}"),
         ))
     }
 }

@@ -260,9 +260,18 @@ pub fn run_data(dir: &Path) -> Result<Value> {
             let on = o.active && o.normal_force > 0.0;
             let f = if on { o.normal_force } else { 0.0 };
             slot[0].push(r(f, 3));
-            for (k, v) in [o.point[0] * 1e3, o.point[1] * 1e3, o.normal[0], o.normal[1]]
-                .into_iter()
-                .enumerate()
+            // Arrows show the force on a contact's second body, the part acted on; the
+            // finger's pad is that body in the model, but the arrow named "finger on key"
+            // is the force on the key.
+            let sign = if *name == "presser_key" { -1.0 } else { 1.0 };
+            for (k, v) in [
+                o.point[0] * 1e3,
+                o.point[1] * 1e3,
+                sign * o.normal[0],
+                sign * o.normal[1],
+            ]
+            .into_iter()
+            .enumerate()
             {
                 slot[1 + k].push(if on {
                     r(v, if k < 2 { 2 } else { 3 })
@@ -491,6 +500,14 @@ pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
         ));
     }
     let runs: Vec<Value> = dirs.iter().map(|d| run_data(d)).collect::<Result<_>>()?;
+    let swings = runs.iter().filter(|r| r["model"] == "pendulum").count();
+    if swings > 0 && swings < runs.len() {
+        return Err(PianoError::option(
+            "RUN_DIR",
+            "a hammer swing (pendulum run) and keystrokes have different plots; give them \
+             separate reports",
+        ));
+    }
     let title = runs
         .iter()
         .filter_map(|r| r["title"].as_str())

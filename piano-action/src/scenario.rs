@@ -324,6 +324,8 @@ pub fn read_points_csv_lines(text: &str, file: &Path) -> Result<(Vec<[f64; 2]>, 
     let mut points: Vec<[f64; 2]> = Vec::new();
     let mut lines = Vec::new();
     let mut first = true;
+    // A spreadsheet's UTF-8 byte-order mark is not part of the first cell.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -334,7 +336,9 @@ pub fn read_points_csv_lines(text: &str, file: &Path) -> Result<(Vec<[f64; 2]>, 
             .filter(|c| !c.is_empty())
             .collect();
         let numbers: Vec<Option<f64>> = cells.iter().map(|c| c.parse().ok()).collect();
-        let header = std::mem::take(&mut first) && numbers.iter().any(Option::is_none);
+        // A header names its columns: no cell of it is a number (a first row with one bad
+        // cell is a typo in the data, not a header).
+        let header = std::mem::take(&mut first) && numbers.iter().all(Option::is_none);
         match numbers.as_slice() {
             _ if header => {}
             [Some(t), Some(v)] => {
@@ -431,10 +435,10 @@ impl Scenario {
     /// Checks what can be checked before running: the model, the duration and output step,
     /// and the input's values (a motion's `csv` is checked when [`Scenario::load`] reads it).
     pub fn check(&self) -> Result<()> {
+        // The pendulum uses the hammer alone, but the model must still be one of ours.
+        self.model_kind()?;
         if let InputSpec::Pendulum(PendulumSpec { release_angle_deg }) = self.input {
             crate::pendulum::check_release_angle(release_angle_deg)?;
-        } else {
-            self.model_kind()?;
         }
         crate::simulate::check_duration(self.duration_s, self.output_step_s)?;
         match &self.input {
@@ -466,14 +470,15 @@ impl Scenario {
         }) = &mut scenario.input
         {
             let full = path.parent().unwrap_or(Path::new(".")).join(&*file);
-            let text = std::fs::read_to_string(&full).map_err(|e| {
+            let csv_text = std::fs::read_to_string(&full).map_err(|e| {
                 PianoError::scenario(
                     "input.csv",
                     format!("cannot read the key motion {}: {e}", full.display()),
                 )
                 .in_file(path)
+                .locate_in_toml(&text)
             })?;
-            let (rows, lines) = read_points_csv_lines(&text, &full)?;
+            let (rows, lines) = read_points_csv_lines(&csv_text, &full)?;
             *points = Some(rows);
             // The points are now in the scenario (and its run.json); the file name stays as
             // a record of where they came from. A bad value is shown at its CSV line.
@@ -589,31 +594,58 @@ fn run_outputs_in(dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     Ok(found)
 }
 
-/// Makes `dir` ready for a new run: created if missing; a folder that holds files of an
-/// earlier run is refused, unless `replace` is set, in which case those files (and only
-/// those: `measured.csv` and anything else of yours stays) are removed first, so old and
-/// new files are never mixed.
-pub fn prepare_run_dir(dir: &Path, replace: bool) -> Result<()> {
+/// Whether `dir` holds a `run.json` written by `piano` (a run directory).
+fn holds_piano_run(dir: &Path) -> bool {
+    std::fs::read_to_string(dir.join("run.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .is_some_and(|v| v.get("scenario").is_some() && v.get("version").is_some())
+}
+
+/// Checks that a run may be written to `dir` without touching anything it should not: a
+/// missing or empty folder is fine, and so is one holding only files of yours; a run
+/// directory of an earlier run only when `replace` is set; a folder holding files named
+/// like a run's but no piano `run.json` never (they are not ours to replace).
+pub fn check_run_dir(dir: &Path, replace: bool) -> Result<()> {
     let old = run_outputs_in(dir)?;
-    if !old.is_empty() {
-        if !replace {
-            let names: Vec<String> = old
-                .iter()
-                .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-                .collect();
-            return Err(PianoError::file(
-                dir,
-                format!(
-                    "holds an earlier run ({}); choose another --out, or pass --force to \
-                     replace it",
-                    names.join(", ")
-                ),
-            ));
-        }
-        for path in old {
-            std::fs::remove_file(&path)
-                .map_err(|e| PianoError::file(&path, format!("cannot remove: {e}")))?;
-        }
+    if old.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<String> = old
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    if !holds_piano_run(dir) {
+        return Err(PianoError::file(
+            dir,
+            format!(
+                "holds files named like a run's ({}) but is not a run directory (no run.json \
+                 written by piano): choose another --out",
+                names.join(", ")
+            ),
+        ));
+    }
+    if !replace {
+        return Err(PianoError::file(
+            dir,
+            format!(
+                "holds an earlier run ({}); choose another --out, or pass --force to replace \
+                 it",
+                names.join(", ")
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Makes `dir` ready for a new run (see [`check_run_dir`]): created if missing; with
+/// `replace`, the files of an earlier run (and only those: `measured.csv` and anything else
+/// of yours stays) are removed first, so old and new files are never mixed.
+pub fn prepare_run_dir(dir: &Path, replace: bool) -> Result<()> {
+    check_run_dir(dir, replace)?;
+    for path in run_outputs_in(dir)? {
+        std::fs::remove_file(&path)
+            .map_err(|e| PianoError::file(&path, format!("cannot remove: {e}")))?;
     }
     std::fs::create_dir_all(dir)
         .map_err(|e| PianoError::file(dir, format!("cannot create the folder: {e}")))

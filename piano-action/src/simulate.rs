@@ -109,15 +109,26 @@ impl Default for Finger {
     }
 }
 
+/// The largest key-front force a run accepts (N) [D]: staccato fortissimo peaks reach
+/// 50 N (Kinoshita et al. 2007); 200 N is four times that.
+pub const MAX_KEY_FORCE_N: f64 = 200.0;
+
+/// The slowest struck finger (m/s) [D]: below about 0.05 m/s the key does not reach the
+/// let-off; 0.01 m/s is a tenth of the softest measured touch (Goebl et al. 2005).
+pub const MIN_FINGER_SPEED_M_S: f64 = 0.01;
+
+/// How far from rest a key motion may start (mm) [D]: a measured table's first sample.
+pub const MOTION_START_TOLERANCE_MM: f64 = 0.05;
+
 impl Input {
     /// Checks the input's values (forces, speeds, masses, tables), naming the bad field.
     pub fn validate(&self) -> Result<()> {
         match *self {
             Input::Force { force_n, release_s } => {
-                if !(force_n.is_finite() && force_n >= 0.0) {
+                if !(force_n.is_finite() && (0.0..=MAX_KEY_FORCE_N).contains(&force_n)) {
                     return Err(PianoError::scenario(
                         "input.force_n",
-                        format!("must be a non-negative force, got {force_n}"),
+                        format!("must be a force of 0 to {MAX_KEY_FORCE_N} N, got {force_n}"),
                     ));
                 }
                 if let Some(t) = release_s
@@ -151,22 +162,23 @@ impl Input {
                 };
                 match style {
                     TouchStyle::Pressed { peak_force_n } => {
-                        if !(peak_force_n.is_finite() && (0.0..=200.0).contains(&peak_force_n)) {
+                        if !(peak_force_n.is_finite()
+                            && (0.0..=MAX_KEY_FORCE_N).contains(&peak_force_n))
+                        {
                             return Err(bad(
                                 "peak_force_n",
-                                format!("must be a force of 0 to 200 N, got {peak_force_n}"),
+                                format!(
+                                    "must be a force of 0 to {MAX_KEY_FORCE_N} N, got {peak_force_n}"
+                                ),
                             ));
                         }
                     }
                     TouchStyle::Struck { finger_speed_m_s } => {
-                        if !(finger_speed_m_s.is_finite()
-                            && finger_speed_m_s > 0.0
-                            && finger_speed_m_s <= 10.0)
-                        {
+                        if !(MIN_FINGER_SPEED_M_S..=10.0).contains(&finger_speed_m_s) {
                             return Err(bad(
                                 "finger_speed_m_s",
                                 format!(
-                                    "must be a speed above 0 and up to 10 m/s, got {finger_speed_m_s}"
+                                    "must be a speed of {MIN_FINGER_SPEED_M_S} to 10 m/s, got {finger_speed_m_s}"
                                 ),
                             ));
                         }
@@ -184,16 +196,30 @@ impl Input {
                 }
                 Ok(())
             }
-            Input::Motion { ref points } => check_table(points, "[time_s, depth_mm]", |d| {
-                (-20.0..=20.0).contains(&d).then_some(()).ok_or_else(|| {
-                    format!("depth {d} mm is outside -20..20 mm (a key dips about 10)")
-                })
-            }),
+            Input::Motion { ref points } => {
+                check_table(points, "[time_s, depth_mm]", |d| {
+                    (-20.0..=20.0).contains(&d).then_some(()).ok_or_else(|| {
+                        format!("depth {d} mm is outside -20..20 mm (a key dips about 10)")
+                    })
+                })?;
+                // The key starts at rest: the table holds its first depth from t = 0.
+                let first = points[0].1;
+                if first.abs() > MOTION_START_TOLERANCE_MM {
+                    return Err(PianoError::scenario(
+                        "input.points[0][1]",
+                        format!(
+                            "the key starts at rest, so the first depth must be 0 mm, got \
+                             {first} mm (the key would jump there at t = 0)"
+                        ),
+                    ));
+                }
+                Ok(())
+            }
             Input::ForceTable { ref points } => check_table(points, "[time_s, force_n]", |f| {
-                (-200.0..=200.0)
+                (-MAX_KEY_FORCE_N..=MAX_KEY_FORCE_N)
                     .contains(&f)
                     .then_some(())
-                    .ok_or_else(|| format!("force {f} N is outside -200..200 N"))
+                    .ok_or_else(|| format!("force {f} N is outside ±{MAX_KEY_FORCE_N} N"))
             }),
         }
     }
@@ -436,7 +462,15 @@ fn key_start_time(
     if let Input::Motion { points } = input {
         // The table was checked before the run.
         let depth = BlendedLinear::new(points, 5e-3).ok()?;
-        let (t0, t1) = (points[0].0 - 5e-3, points[points.len() - 1].0 + 5e-3);
+        // Search from the table's start to its end, but not past the run's end.
+        let end = solution.t.last().copied().unwrap_or(0.0);
+        let (t0, t1) = (
+            (points[0].0 - 5e-3).max(0.0),
+            (points[points.len() - 1].0 + 5e-3).min(end),
+        );
+        if t1 < t0 {
+            return None;
+        }
         let n = ((t1 - t0) / 1e-5).ceil() as usize;
         return (0..=n)
             .map(|i| t0 + i as f64 * 1e-5)
@@ -576,9 +610,9 @@ pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<
 /// second, a repeated-note pattern in a few, the hammer swing test rings down in tens.
 pub const MAX_DURATION_S: f64 = 60.0;
 
-/// The most output points a run keeps [D]: a million rows of `trajectory.csv` is already
-/// a few hundred megabytes.
-pub const MAX_OUTPUT_POINTS: f64 = 1e6;
+/// The most output points a run keeps [D]: 200 000 rows of `trajectory.csv` and
+/// `contacts.csv` are already some 120 MB (a minute at 0.3 ms).
+pub const MAX_OUTPUT_POINTS: f64 = 2e5;
 
 /// Checks a run's `duration_s` and `output_step_s` before anything runs: positive, finite,
 /// at most [`MAX_DURATION_S`], and at most [`MAX_OUTPUT_POINTS`] output points.
@@ -610,7 +644,7 @@ pub fn check_duration(duration_s: f64, output_step_s: f64) -> Result<()> {
             "output_step_s",
             format!(
                 "{output_step_s} s over {duration_s} s gives {points:.3e} output points, more \
-                 than the {MAX_OUTPUT_POINTS:.0e} a run keeps; choose a longer output step"
+                 than the {MAX_OUTPUT_POINTS} a run keeps; choose a longer output step"
             ),
         ));
     }

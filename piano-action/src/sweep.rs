@@ -64,8 +64,11 @@ impl SweepKind {
 /// `n` values from `from` to `to`, evenly spaced on a log scale (both must be positive) or
 /// a linear one.
 pub fn levels(from: f64, to: f64, n: usize, log: bool) -> Result<Vec<f64>> {
-    if n == 0 {
-        return Err(PianoError::option("--runs", "needs at least one run"));
+    if n == 0 || n > MAX_RUNS {
+        return Err(PianoError::option(
+            "--runs",
+            format!("must be 1 to {MAX_RUNS}, got {n}"),
+        ));
     }
     for (flag, v) in [("--from", from), ("--to", to)] {
         if !v.is_finite() {
@@ -85,13 +88,37 @@ pub fn levels(from: f64, to: f64, n: usize, log: bool) -> Result<Vec<f64>> {
             } else {
                 i as f64 / (n - 1) as f64
             };
-            if log {
+            if i == 0 {
+                from
+            } else if i == n - 1 {
+                // The ends are the levels asked for, not their round-off.
+                to
+            } else if log {
                 (from.ln() + u * (to.ln() - from.ln())).exp()
             } else {
                 from + u * (to - from)
             }
         })
         .collect())
+}
+
+/// The most runs one sweep takes [D]: 100 000 keystrokes are some ten minutes on two cores.
+pub const MAX_RUNS: usize = 100_000;
+
+/// Checks every level of a sweep before any runs: the input it makes must be valid (a
+/// finger speed, a force in range); the error names `--from` or `--to`.
+pub fn check_levels(kind: SweepKind, values: &[f64]) -> Result<()> {
+    for (i, &v) in values.iter().enumerate() {
+        if let Err(e) = kind.input(v).validate() {
+            let flag = if i == 0 { "--from" } else { "--to" };
+            let why = e.as_input().map_or(e.to_string(), |b| b.message.clone());
+            return Err(PianoError::option(
+                flag,
+                format!("the {} level {v}: {why}", kind.name()),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// One run of a sweep.

@@ -431,13 +431,25 @@ fn report_and_plot_write_their_files_and_keep_yours() {
     ]);
     assert!(!ok && err.contains("not a piano report"), "{err}");
     assert_eq!(std::fs::read_to_string(&other).unwrap(), "mine");
+    // A figure is written only to a file named for its format, and never over yours.
     let (ok, _, err) = piano(&[
         "plot",
         run.to_str().unwrap(),
         "--out",
         other.to_str().unwrap(),
     ]);
+    assert!(!ok && err.contains("must end in .svg"), "{err}");
+    assert_eq!(std::fs::read_to_string(&other).unwrap(), "mine");
+    let mine_svg = dir.join("mine.svg");
+    std::fs::write(&mine_svg, "mine").unwrap();
+    let (ok, _, err) = piano(&[
+        "plot",
+        run.to_str().unwrap(),
+        "--out",
+        mine_svg.to_str().unwrap(),
+    ]);
     assert!(!ok && err.contains("exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&mine_svg).unwrap(), "mine");
     let (ok, out, err) = piano(&["plot", run.to_str().unwrap(), "--format", "png"]);
     if ok {
         assert!(run.join("figure.png").exists(), "{out}");

@@ -223,3 +223,114 @@ fn negative_numbers_are_accepted_as_option_values() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Regressions found by the review of issue 11.
+#[test]
+fn review_findings_stay_fixed() {
+    let dir = folder("review");
+    let scenario = dir.join("s.toml");
+    // A motion table running far past the duration finishes (it used to search the whole
+    // table in 10 µs steps after the run).
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.1\n[input]\nkind = \"motion\"\npoints = [[0, 0], [1e9, 5]]\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&dir.join("far"))]);
+    assert!(ok, "{err}");
+    // A motion that starts away from rest would make the key jump at t = 0.
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.1\n[input]\nkind = \"motion\"\npoints = [[0, 10], [0.1, 10]]\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&dir.join("jump"))]);
+    assert!(!ok && err.contains("`input.points[0][1]`"), "{err}");
+    // A motion CSV from a spreadsheet (byte-order mark, CRLF) reads; a typo in the first
+    // row is not taken for a header.
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.05\n[input]\nkind = \"motion\"\ncsv = \"m.csv\"\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("m.csv"), "\u{feff}0,0\r\n0.02,10\r\n").unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&dir.join("bom"))]);
+    assert!(ok, "{err}");
+    std::fs::write(dir.join("m.csv"), "0,O\n0.02,10\n").unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&dir.join("typo"))]);
+    assert!(
+        !ok && err.contains("m.csv, line 1") && err.contains("'O'"),
+        "{err}"
+    );
+    // A refused scenario with --force leaves the earlier run alone.
+    let keep = dir.join("keep");
+    std::fs::write(&scenario, LOUD).unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&keep)]);
+    assert!(ok, "{err}");
+    std::fs::write(&scenario, LOUD.replace("20.0", "1e12")).unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&keep), "--force"]);
+    assert!(!ok && err.contains("`input.force_n`"), "{err}");
+    assert!(keep.join("trajectory.csv").exists());
+    // Files of yours that merely share a run's names are not a run: never replaced.
+    let mine = dir.join("mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("summary.json"), "{}").unwrap();
+    std::fs::write(&scenario, LOUD).unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&mine), "--force"]);
+    assert!(!ok && err.contains("not a run directory"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(mine.join("summary.json")).unwrap(),
+        "{}"
+    );
+    // Sweeps: too many runs, levels no run accepts, and a folder as the output.
+    let out = dir.join("s.csv");
+    let (ok, _, err) = piano(&["sweep", "--runs", "1000000000000", "--out", s(&out)]);
+    assert!(!ok && err.contains("option --runs"), "{err}");
+    let (ok, _, err) = piano(&["sweep", "--from", "50", "--to", "100", "--out", s(&out)]);
+    assert!(!ok && err.contains("option --from"), "{err}");
+    let (ok, _, err) = piano(&["sweep", "--runs", "-1", "--out", s(&out)]);
+    assert!(
+        !ok && err.contains("-1") && !err.contains("unexpected argument"),
+        "{err}"
+    );
+    let (ok, _, err) = piano(&["sweep", "--out", s(&dir)]);
+    assert!(!ok && err.contains("option --out"), "{err}");
+    assert!(!out.exists());
+    // A parameter that resists motion cannot be negative; --params where it is not used.
+    let (_, text, _) = piano(&["params"]);
+    let params = dir.join("p.toml");
+    std::fs::write(
+        &params,
+        text.replacen(
+            "stop_stiffness_n_m_per_rad = 50.0",
+            "stop_stiffness_n_m_per_rad = -50.0",
+            1,
+        ),
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&["--params", s(&params), "touchweight"]);
+    assert!(
+        !ok && err.contains("field `numerics.stop_stiffness_n_m_per_rad`"),
+        "{err}"
+    );
+    let (ok, _, err) = piano(&["--params", s(&params), "plot", s(&keep)]);
+    assert!(!ok && err.contains("option --params"), "{err}");
+    // A hammer swing and a keystroke do not share a report.
+    let swing = dir.join("swing");
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.5\n[input]\nkind = \"pendulum\"\nrelease_angle_deg = 170\n",
+    )
+    .unwrap();
+    let (ok, _, err) = piano(&["simulate", s(&scenario), "--out", s(&swing)]);
+    assert!(ok, "170° is accepted, as its message says: {err}");
+    let (ok, _, err) = piano(&[
+        "report",
+        s(&swing),
+        s(&keep),
+        "--out",
+        s(&dir.join("r.html")),
+    ]);
+    assert!(!ok && err.contains("separate reports"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -306,3 +306,18 @@ fn other_impossible_layouts_name_their_field() {
         refused(&p, field, &[words]);
     }
 }
+
+#[test]
+fn a_wippen_pinned_inside_the_key_is_refused() {
+    // Found in review: the wippen drawn through the key stick, striking four times.
+    let mut p = ActionParams::reference();
+    p.wippen.pivot_mm = [187.0, 10.0];
+    let problems = check(&p);
+    assert!(
+        problems
+            .iter()
+            .any(|q| q.field == "wippen.pivot_mm" && q.message.contains("not above the key")),
+        "{problems:#?}"
+    );
+    assert!(p.validate().is_err());
+}

@@ -292,3 +292,21 @@ fn the_page_lists_the_events_a_reader_should_see_and_keeps_them_all() {
         count(all, "string_contact_start")
     );
 }
+
+#[test]
+fn the_finger_on_key_arrow_pushes_the_key_down() {
+    // Found in review: the arrow named "finger on key" showed the force on the finger (up).
+    let dir = run_dir("finger-arrow", STRUCK);
+    let data = embedded(&report_html(std::slice::from_ref(&dir)).unwrap());
+    let c = &data["runs"][0]["contacts"]["presser_key"];
+    let f: Vec<f64> = c["f"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let peak = (0..f.len()).max_by(|&a, &b| f[a].total_cmp(&f[b])).unwrap();
+    assert!(f[peak] > 5.0, "the finger presses with {} N", f[peak]);
+    let ny = c["ny"][peak].as_f64().unwrap();
+    assert!(ny < -0.9, "finger-on-key arrow direction {ny}");
+}
