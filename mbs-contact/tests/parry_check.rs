@@ -423,15 +423,23 @@ struct Diff {
 impl Diff {
     fn between(x: &Answer, y: &Answer) -> Diff {
         Diff {
-            gap: (x.gap - y.gap).abs(),
-            normal: norm(sub(x.normal, y.normal)),
-            points: norm(sub(x.point_a, y.point_a)).max(norm(sub(x.point_b, y.point_b))),
+            gap: nan_is_worst((x.gap - y.gap).abs()),
+            normal: nan_is_worst(norm(sub(x.normal, y.normal))),
+            points: nan_is_worst(
+                norm(sub(x.point_a, y.point_a)).max(norm(sub(x.point_b, y.point_b))),
+            ),
         }
     }
 
     fn largest(&self) -> f64 {
         self.gap.max(self.normal).max(self.points)
     }
+}
+
+/// A difference that is NaN (one side answered NaN) counts as infinitely wrong: `f64::max`
+/// would otherwise drop it and let the case pass.
+fn nan_is_worst(d: f64) -> f64 {
+    if d.is_nan() { f64::INFINITY } else { d }
 }
 
 /// One case compared both ways round: the differences, and both answers A then B.

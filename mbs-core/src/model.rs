@@ -190,22 +190,27 @@ impl Model {
     }
 
     /// Joint connecting a moving body to its parent (`None` for the ground).
+    /// `None` for the ground and for an id that is not one of this model's bodies.
     pub fn joint_type(&self, body: BodyId) -> Option<JointType> {
-        (body.0 > 0).then(|| self.bodies[body.0].joint)
+        (body.0 > 0)
+            .then(|| self.bodies.get(body.0).map(|b| b.joint))
+            .flatten()
     }
 
-    /// Pose of a moving body's joint frame in its parent's joint frame at zero coordinate.
-    pub fn joint_placement(&self, body: BodyId) -> Transform {
-        self.bodies[body.0].x_tree
+    /// Pose of a moving body's joint frame in its parent's joint frame at zero coordinate;
+    /// `None` for an id that is not one of this model's bodies.
+    pub fn joint_placement(&self, body: BodyId) -> Option<Transform> {
+        self.bodies.get(body.0).map(|b| b.x_tree)
     }
 
     /// Rigid-body inertia of a moving body (including fixed children merged into it) in its
-    /// joint frame; zero for the ground.
-    pub fn inertia(&self, body: BodyId) -> Inertia {
+    /// joint frame; zero for the ground, `None` for an id that is not one of this model's
+    /// bodies.
+    pub fn inertia(&self, body: BodyId) -> Option<Inertia> {
         if body.0 == 0 {
-            Inertia::ZERO
+            Some(Inertia::ZERO)
         } else {
-            self.bodies[body.0].inertia
+            self.bodies.get(body.0).map(|b| b.inertia)
         }
     }
 
@@ -215,8 +220,11 @@ impl Model {
     }
 
     /// Coordinate index (into q, v, a, τ) of a moving body's joint; `None` for the ground.
+    /// `None` also for an id that is not one of this model's bodies.
     pub fn coordinate_of(&self, body: BodyId) -> Option<usize> {
-        (body.0 > 0).then(|| self.bodies[body.0].idx_v)
+        (body.0 > 0)
+            .then(|| self.bodies.get(body.0).map(|b| b.idx_v))
+            .flatten()
     }
 
     /// Body moved by coordinate `k`.
@@ -267,9 +275,14 @@ impl Model {
         &self.frames
     }
 
-    /// Ancestors of a body from itself up to (not including) the ground.
+    /// Ancestors of a body from itself up to (not including) the ground; empty for an id
+    /// that is not one of this model's bodies.
     pub fn support(&self, body: BodyId) -> impl Iterator<Item = BodyId> + '_ {
-        let mut i = body.0;
+        let mut i = if body.0 < self.bodies.len() {
+            body.0
+        } else {
+            0
+        };
         std::iter::from_fn(move || {
             if i == 0 {
                 None

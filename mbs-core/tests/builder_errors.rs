@@ -813,7 +813,10 @@ fn fixed_joint_merges_inertia_into_parent() {
     let by_hand = by_hand.build().unwrap();
 
     let upper = with_fixed.body_id("upper").unwrap();
-    let (got, want) = (with_fixed.inertia(upper), by_hand.inertia(upper));
+    let (got, want) = (
+        with_fixed.inertia(upper).unwrap(),
+        by_hand.inertia(upper).unwrap(),
+    );
     for (g, w) in [
         (got.m, want.m),
         (got.hx, want.hx),

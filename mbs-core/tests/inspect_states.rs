@@ -75,4 +75,11 @@ fn body_name_of_a_foreign_id_is_none_not_a_panic() {
     assert_eq!(small.parent(foreign), None);
     assert_eq!(big.body_name(foreign), Some("link2"));
     assert_eq!(big.parent(foreign), big.body_id("link1").ok());
+    // Every lookup by body id answers None (or nothing) for a foreign id.
+    assert!(small.joint_type(foreign).is_none());
+    assert!(small.joint_placement(foreign).is_none());
+    assert!(small.inertia(foreign).is_none());
+    assert!(small.coordinate_of(foreign).is_none());
+    assert_eq!(small.support(foreign).count(), 0);
+    assert_eq!(big.support(foreign).count(), 2);
 }
