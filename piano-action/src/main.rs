@@ -27,7 +27,8 @@ enum Command {
     /// and print a summary (the default).
     Demo,
     /// Run a scenario (TOML: `model`, `duration_s`, `[input]`) and write its run directory
-    /// (run.json, trajectory.csv, events.json, summary.json).
+    /// (run.json, trajectory.csv, contacts.csv, events.json, summary.json and SVG drawings
+    /// of the action at rest, let-off, string contact and check).
     Simulate {
         /// The scenario file.
         scenario: std::path::PathBuf,
