@@ -64,7 +64,9 @@ impl StatesFile {
     }
 }
 
-/// Evaluates every state; an error names the state index and what is wrong with it.
+/// Evaluates every state; an error names the state index and what is wrong with it: a
+/// vector of the wrong length, a non-finite entry, or numbers so large that a result
+/// overflows (a report holds only finite numbers).
 pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
     let mut data = Data::new(model);
     let n = model.nv();
@@ -75,7 +77,7 @@ pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
             message: e.to_string(),
         };
         let m = crba(model, &mut data, &s.q).map_err(at)?;
-        let mass_matrix = (0..n)
+        let mass_matrix: Vec<Vec<f64>> = (0..n)
             .map(|i| (0..n).map(|j| m[(i, j)]).collect())
             .collect();
         let rnea_tau = rnea(model, &mut data, &s.q, &s.v, &s.a)
@@ -94,6 +96,25 @@ pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
             .map_err(at)?
             .as_slice()
             .to_vec();
+        let mass_entries = mass_matrix.concat();
+        let outputs = [
+            ("mass_matrix", &mass_entries),
+            ("rnea_tau", &rnea_tau),
+            ("nonlinear_effects", &nle),
+            ("gravity_torque", &g),
+            ("aba_qdd", &qdd),
+        ];
+        for (what, values) in outputs {
+            if let Some(value) = values.iter().find(|x| !x.is_finite()) {
+                return Err(CoreError::InvalidParameter {
+                    item: format!("states[{k}]"),
+                    message: format!(
+                        "{what} is not finite ({value}): q, v, a or tau are too large for \
+                         the model"
+                    ),
+                });
+            }
+        }
         states.push(StateReport {
             mass_matrix,
             rnea_tau,
