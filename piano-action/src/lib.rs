@@ -21,6 +21,8 @@
 mod action;
 pub mod drawing;
 mod error;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod params;
 pub mod pendulum;
 pub mod plot;
