@@ -67,3 +67,28 @@ fn inspect_nan_state_is_named() {
         "{err}"
     );
 }
+
+/// serde_json's default float parser may be off by one unit in the last place (`21e300`
+/// read as 2.1000000000000002e301), so a description written by `to_json_string` and read
+/// back was a different model. The workspace now enables serde_json's `float_roundtrip`:
+/// numbers are read exactly as Rust's `str::parse` reads them.
+#[test]
+fn model_json_numbers_were_parsed_inexactly_so_round_trip_changed() {
+    use mbs_core::ModelDescription;
+    for text in [
+        "21e300",
+        "0.1",
+        "2.2250738585072011e-308",
+        "9007199254740993",
+        "1.7976931348623157e308",
+        "4.9e-324",
+        "123456789.123456789e-5",
+    ] {
+        let json = format!(r#"{{"gravity": [0.0, {text}], "joints": []}}"#);
+        let d = ModelDescription::from_json_str(&json).unwrap();
+        let exact: f64 = text.parse().unwrap();
+        assert_eq!(d.gravity[1].to_bits(), exact.to_bits(), "{text}");
+        let again = ModelDescription::from_json_str(&d.to_json_string()).unwrap();
+        assert_eq!(again, d, "{text}");
+    }
+}
