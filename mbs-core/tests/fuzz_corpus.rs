@@ -1,9 +1,9 @@
 //! Replays the committed fuzzing corpora of `fuzz/corpus/model_json` and
-//! `fuzz/corpus/states_json` through the fuzz targets' own bodies
-//! ([`mbs_core::fuzzing`]) on the stable toolchain, without libFuzzer: every file is run
-//! (the corpora are minimised and replay in well under a second). A panic, or an input that
-//! breaks one of the harness's checks, fails the test with the file's name. A missing
-//! corpus folder is a failure, not a skip.
+//! `fuzz/corpus/states_json` through the fuzz targets' own bodies ([`mbs_core::fuzzing`])
+//! on the stable toolchain, without libFuzzer: every file is run (the corpora are minimised
+//! on edge coverage and replay in well under a second in the debug build). A panic, or an
+//! input that breaks one of the harness's checks, fails the test with the file's name. A
+//! missing corpus folder is a failure, not a skip.
 
 use std::path::{Path, PathBuf};
 

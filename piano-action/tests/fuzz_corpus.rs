@@ -1,10 +1,10 @@
 //! Replays the committed fuzzing corpora of `fuzz/corpus/params_toml`,
 //! `fuzz/corpus/scenario_toml` and `fuzz/corpus/motion_csv` through the fuzz targets' own
-//! bodies ([`piano_action::fuzzing`]) on the stable toolchain, without libFuzzer: every file
-//! is run (the corpora are minimised; the parameter corpus, which assembles the three models
-//! for each accepted file, is the slowest at about a second in the debug build). A panic, or
-//! an input that breaks one of the harness's checks, fails the test with the file's name. A
-//! missing corpus folder is a failure, not a skip.
+//! bodies ([`piano_action::fuzzing`]) on the stable toolchain, without libFuzzer: every
+//! file is run (the corpora are minimised on edge coverage: the three replay in well under
+//! a second in the debug build). A panic, or an input that breaks one of the harness's
+//! checks, fails the test with the file's name. A missing corpus folder is a failure, not a
+//! skip.
 
 use std::path::{Path, PathBuf};
 
