@@ -95,7 +95,9 @@ impl StatesFile {
     }
 }
 
-/// Evaluates every state; an error names the state index and what is wrong with it.
+/// Evaluates every state; an error names the state index and what is wrong with it: a
+/// vector of the wrong length, a non-finite entry, or numbers so large that a result
+/// overflows (a report holds only finite numbers).
 pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
     let mut data = Data::new(model);
     let n = model.nv();
@@ -103,7 +105,7 @@ pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
     for (k, s) in input.states.iter().enumerate() {
         let at = |e: CoreError| CoreError::States(format!("field `states[{k}]`: {e}"));
         let m = crba(model, &mut data, &s.q).map_err(at)?;
-        let mass_matrix = (0..n)
+        let mass_matrix: Vec<Vec<f64>> = (0..n)
             .map(|i| (0..n).map(|j| m[(i, j)]).collect())
             .collect();
         let rnea_tau = rnea(model, &mut data, &s.q, &s.v, &s.a)
@@ -122,34 +124,31 @@ pub fn inspect(model: &Model, input: &StatesFile) -> Result<ReportFile> {
             .map_err(at)?
             .as_slice()
             .to_vec();
-        let report = StateReport {
+        // A finite state can still overflow (v = 1e300 squares to infinity): say so rather
+        // than print `null`.
+        let mass_entries = mass_matrix.concat();
+        let outputs = [
+            ("mass_matrix", &mass_entries),
+            ("rnea_tau", &rnea_tau),
+            ("nonlinear_effects", &nle),
+            ("gravity_torque", &g),
+            ("aba_qdd", &qdd),
+        ];
+        for (what, values) in outputs {
+            if let Some(value) = values.iter().find(|x| !x.is_finite()) {
+                return Err(CoreError::States(format!(
+                    "field `states[{k}]`: {what} is not finite ({value}): q, v, a or tau are \
+                     too large for the model"
+                )));
+            }
+        }
+        states.push(StateReport {
             mass_matrix,
             rnea_tau,
             nonlinear_effects: nle,
             gravity_torque: g,
             aba_qdd: qdd,
-        };
-        // A finite state can still overflow (v = 1e300 squares to infinity): say so rather
-        // than print `null`.
-        for (name, values) in [
-            ("rnea_tau", &report.rnea_tau),
-            ("nonlinear_effects", &report.nonlinear_effects),
-            ("gravity_torque", &report.gravity_torque),
-            ("aba_qdd", &report.aba_qdd),
-        ] {
-            if values.iter().any(|v| !v.is_finite()) {
-                return Err(CoreError::States(format!(
-                    "field `states[{k}]`: {name} is not finite (the state's values are too \
-                     large to evaluate)"
-                )));
-            }
-        }
-        if report.mass_matrix.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(CoreError::States(format!(
-                "field `states[{k}]`: the mass matrix is not finite"
-            )));
-        }
-        states.push(report);
+        });
     }
     Ok(ReportFile { states })
 }

@@ -58,6 +58,8 @@ pub mod elements;
 mod energy;
 mod error;
 mod force;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod inspect;
 mod jacobian;
 mod kinematics;

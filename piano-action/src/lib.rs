@@ -22,6 +22,8 @@
 mod action;
 pub mod drawing;
 mod error;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod geometry_check;
 pub mod measured;
 pub mod params;
