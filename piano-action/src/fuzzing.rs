@@ -130,3 +130,52 @@ pub fn motion_csv(bytes: &[u8]) -> bool {
         }
     }
 }
+
+/// The file name the `measured_csv` target passes; every error must name it.
+pub const MEASURED_CSV_NAME: &str = "fuzz_measured.csv";
+
+/// The columns the `measured_csv` target accepts: the report's plotted series.
+pub const MEASURED_COLUMNS: [&str; 6] = [
+    "hammer_angle_deg",
+    "hammer_speed_m_s",
+    "key_depth_mm",
+    "kinetic_mj",
+    "gravity_mj",
+    "key_drive_force_n",
+];
+
+/// Target `measured_csv`: reads a `measured.csv`. What it accepts holds only finite
+/// numbers, times from 0 on and increasing in every series, and one series per column.
+pub fn measured_csv(bytes: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return false;
+    };
+    let path = std::path::Path::new(MEASURED_CSV_NAME);
+    match crate::measured::parse_measured(text, path, &MEASURED_COLUMNS) {
+        Ok(series) => {
+            for s in &series {
+                assert!(
+                    MEASURED_COLUMNS.contains(&s.id.as_str()) && s.t.len() == s.v.len(),
+                    "fuzz oracle: measured series {} is malformed",
+                    s.id
+                );
+                assert!(
+                    s.t.iter().chain(&s.v).all(|x| x.is_finite())
+                        && s.t.first().is_none_or(|&t| t >= 0.0)
+                        && s.t.windows(2).all(|w| w[1] > w[0]),
+                    "fuzz oracle: measured series {} has bad times or values",
+                    s.id
+                );
+            }
+            true
+        }
+        Err(e) => {
+            check_message("parse_measured", &e);
+            assert!(
+                e.to_string().contains(MEASURED_CSV_NAME),
+                "fuzz oracle: parse_measured error does not name the file: {e}"
+            );
+            false
+        }
+    }
+}

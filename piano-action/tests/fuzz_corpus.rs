@@ -1,5 +1,6 @@
 //! Replays the committed fuzzing corpora of `fuzz/corpus/params_toml`,
-//! `fuzz/corpus/scenario_toml` and `fuzz/corpus/motion_csv` through the fuzz targets' own
+//! `fuzz/corpus/scenario_toml`, `fuzz/corpus/motion_csv` and `fuzz/corpus/measured_csv`
+//! through the fuzz targets' own
 //! bodies ([`piano_action::fuzzing`]) on the stable toolchain, without libFuzzer: every
 //! file is run (the corpora are minimised on edge coverage: the three replay in well under
 //! a second in the debug build). A panic, or an input that breaks one of the harness's
@@ -63,4 +64,10 @@ fn scenario_toml_corpus_replays_without_panics() {
 fn motion_csv_corpus_replays_without_panics() {
     let accepted = replay("motion_csv", piano_action::fuzzing::motion_csv);
     assert!(accepted > 0, "no motion file of the corpus is accepted");
+}
+
+#[test]
+fn measured_csv_corpus_replays_without_panics() {
+    let accepted = replay("measured_csv", piano_action::fuzzing::measured_csv);
+    assert!(accepted > 0, "no measured file of the corpus is accepted");
 }
