@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(model_json states_json params_toml scenario_toml motion_csv)
+[ ${#targets[@]} -eq 0 ] && targets=(model_json states_json params_toml scenario_toml motion_csv measured_csv)
 for t in "${targets[@]}"; do
     cargo +nightly fuzz build "$t" >/dev/null 2>&1
     bin="fuzz/target/x86_64-unknown-linux-gnu/release/$t"
