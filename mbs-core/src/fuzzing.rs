@@ -192,3 +192,39 @@ pub fn states_json_on(model: &Model, bytes: &[u8]) -> bool {
         }
     }
 }
+
+/// Runs `body` on every file of the corpus folder `corpus_root/target` in name order (the
+/// replay in `cargo test` of what the fuzzer found), naming the file of a panic; returns
+/// how many inputs were accepted. Panics if the folder is missing or empty: the corpora
+/// are committed, and a replay that finds nothing must not pass quietly.
+pub fn replay_corpus(
+    corpus_root: &std::path::Path,
+    target: &str,
+    body: impl Fn(&[u8]) -> bool,
+) -> usize {
+    let dir = corpus_root.join(target);
+    let entries = std::fs::read_dir(&dir).unwrap_or_else(|e| {
+        panic!(
+            "fuzz corpus {} is missing ({e}): it is committed with the repository",
+            dir.display()
+        )
+    });
+    let mut files: Vec<std::path::PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "fuzz corpus {} is empty", dir.display());
+    let mut accepted = 0;
+    for path in &files {
+        let bytes = std::fs::read(path)
+            .unwrap_or_else(|e| panic!("cannot read corpus file {}: {e}", path.display()));
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(&bytes)));
+        match outcome {
+            Ok(ok) => accepted += usize::from(ok),
+            Err(_) => panic!("{target}: input {} panicked (see above)", path.display()),
+        }
+    }
+    println!("{target}: {} inputs, {accepted} accepted", files.len());
+    accepted
+}

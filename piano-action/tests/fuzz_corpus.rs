@@ -7,43 +7,10 @@
 //! checks, fails the test with the file's name. A missing corpus folder is a failure, not a
 //! skip.
 
-use std::path::{Path, PathBuf};
-
-/// The files of `fuzz/corpus/<target>`, sorted; panics if the folder is missing or empty.
-fn corpus(target: &str) -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/corpus")
-        .join(target);
-    let entries = std::fs::read_dir(&dir).unwrap_or_else(|e| {
-        panic!(
-            "fuzz corpus {} is missing ({e}): it is committed with the repository",
-            dir.display()
-        )
-    });
-    let mut files: Vec<PathBuf> = entries
-        .map(|e| e.expect("readable corpus entry").path())
-        .filter(|p| p.is_file())
-        .collect();
-    files.sort();
-    assert!(!files.is_empty(), "fuzz corpus {} is empty", dir.display());
-    files
-}
-
-/// Runs `body` on every file of the corpus, naming the file of a panic; returns how many
-/// inputs were accepted.
+/// Replays the corpus of `target` through `body` (see [`mbs_core::fuzzing::replay_corpus`]).
 fn replay(target: &str, body: impl Fn(&[u8]) -> bool) -> usize {
-    let files = corpus(target);
-    let mut accepted = 0;
-    for path in &files {
-        let bytes = std::fs::read(path).expect("readable corpus file");
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| body(&bytes)));
-        match outcome {
-            Ok(ok) => accepted += usize::from(ok),
-            Err(_) => panic!("{target}: input {} panicked (see above)", path.display()),
-        }
-    }
-    println!("{target}: {} inputs, {accepted} accepted", files.len());
-    accepted
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus");
+    mbs_core::fuzzing::replay_corpus(&root, target, body)
 }
 
 #[test]
