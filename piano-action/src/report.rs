@@ -162,6 +162,21 @@ fn contact_label(name: &str, input: &InputSpec) -> String {
     }
 }
 
+/// A run's name on the page: its folder's name.
+fn run_name(dir: &Path) -> String {
+    dir.file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| dir.display().to_string())
+}
+
+/// Plotted series as the page reads them: `[{id, label, values}]`.
+fn series_to_json(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Value> {
+    series
+        .into_iter()
+        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
+        .collect()
+}
+
 /// The report data of one run directory (see the module docs).
 pub fn run_data(dir: &Path) -> Result<Value> {
     let run = read_json(dir, "run.json")?;
@@ -343,15 +358,9 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         .map(|c| (c.to_string(), json!(contact_label(c, &scenario.input))))
         .collect();
     let measured = read_measured(dir, &series)?;
-    let series_json: Vec<Value> = series
-        .into_iter()
-        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
-        .collect();
+    let series_json = series_to_json(series);
     let events = read_json(dir, "events.json")?;
-    let name = dir
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| dir.display().to_string());
+    let name = run_name(dir);
     Ok(json!({
         "name": name,
         "title": format!("{} action, {}", kind.name(), describe(&scenario.input)),
@@ -429,15 +438,9 @@ fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> R
     }
     let events = read_json(dir, "events.json")?;
     let measured = read_measured(dir, &series)?;
-    let series_json: Vec<Value> = series
-        .into_iter()
-        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
-        .collect();
+    let series_json = series_to_json(series);
     let [a, x, y] = carry;
-    let name = dir
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| dir.display().to_string());
+    let name = run_name(dir);
     Ok(json!({
         "name": name,
         "title": format!("hammer swing, released {release_angle_deg}° from hanging"),
