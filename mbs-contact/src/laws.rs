@@ -493,6 +493,22 @@ impl HystereticFelt {
         })
     }
 
+    /// The felt whose restitution is `e` (in `(0, 1]`) at every impact speed well above
+    /// `v_ε`: a mass loads it along `K(1 + a)δᵖ` and unloads along `K(1 − a)δᵖ`, so
+    /// `e² = (1 − a)/(1 + a)`, i.e. `a = (1 − e²)/(1 + e²)`. No reference speed enters:
+    /// unlike Hunt–Crossley, a slow impact loses the same fraction of its energy as a fast
+    /// one. Errors name `hysteretic_felt.restitution` and the fields of
+    /// [`HystereticFelt::new`].
+    pub fn from_restitution(stiffness: f64, exponent: f64, e: f64, v_eps: f64) -> Result<Self> {
+        let e = check_fraction("hysteretic_felt", "restitution", e, true)?;
+        Self::new(stiffness, exponent, (1.0 - e * e) / (1.0 + e * e), v_eps)
+    }
+
+    /// The restitution of an impact much faster than `v_ε`: `√((1 − a)/(1 + a))`.
+    pub fn restitution(&self) -> f64 {
+        ((1.0 - self.hysteresis) / (1.0 + self.hysteresis)).sqrt()
+    }
+
     /// Stiffness `K` (N/mᵖ).
     pub fn stiffness(&self) -> f64 {
         self.stiffness

@@ -448,6 +448,26 @@ fn hysteretic_felt_branch_ratio() {
 }
 
 #[test]
+fn hysteretic_felt_restitution_does_not_depend_on_the_impact_speed() {
+    // A felt pad given e = 0.4 keeps it from a slow settle (0.05 m/s) to a hard blow (2 m/s),
+    // where Hunt–Crossley given the same e at a 1 m/s reference gives 0.97 and 0.44 (exact
+    // relation): no reference speed sets the loss.
+    let felt = HystereticFelt::from_restitution(1.3e7, 2.0, 0.4, 1e-3).unwrap();
+    assert!((felt.restitution() - 0.4).abs() < 1e-12);
+    for v0 in [0.05, 0.2, 2.0] {
+        let r = impact(&felt, 0.05, v0);
+        assert!(
+            (r.restitution - 0.4).abs() < 0.02,
+            "v0 = {v0}: e = {}",
+            r.restitution
+        );
+    }
+    let hc = HuntCrossley::from_restitution(1.3e7, 2.0, 0.4, 1.0).unwrap();
+    assert!(hc.restitution_at(0.05) > 0.95 && hc.restitution_at(2.0) < 0.5);
+    assert!(HystereticFelt::from_restitution(1e7, 2.0, 0.0, 1e-3).is_err());
+}
+
+#[test]
 fn stulov_state_reproduces_the_hereditary_integral() {
     // For xᵖ = c t (a ramp in xᵖ), (1/τ0) ∫₀ᵗ c ξ e^{(ξ−t)/τ0} dξ = c (t − τ0 (1 − e^{−t/τ0})),
     // so F = f0 [c t − ε c (t − τ0 (1 − e^{−t/τ0}))]. Drive the state with x = (c t)^{1/p}.

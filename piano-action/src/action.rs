@@ -11,7 +11,8 @@
 //!   down;
 //! - hammer: revolute at its flange, positive when the head rises.
 //!
-//! Contacts (Hunt–Crossley felt laws with regularised Coulomb friction where μ > 0):
+//! Contacts (rate-independent hysteretic felt laws with regularised Coulomb friction where
+//! μ > 0):
 //! key–front rail, key–back rail, capstan–heel, jack–knuckle, lever–knuckle, jack
 //! toe–let-off button, lever tip–drop screw, tail–backcheck, shank–rest rail,
 //! hammer–string. Springs: repetition and jack springs, with their stops as joint limits.
@@ -19,7 +20,7 @@
 
 use std::collections::BTreeMap;
 
-use mbs_contact::laws::{HuntCrossley, RegularizedCoulomb};
+use mbs_contact::laws::{HystereticFelt, RegularizedCoulomb};
 use mbs_contact::{Contact, ContactSide, Shape};
 use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::elements::{FrictionLaw, JointLimit, JointSpringDamper, PivotFriction, SpringLaw};
@@ -119,7 +120,7 @@ pub struct Presser {
 }
 
 impl Presser {
-    /// A weight of `mass_kg` with its firm pad (Hunt–Crossley k = 1e7, p = 1.5, e = 0.5
+    /// A weight of `mass_kg` with its firm pad (felt law k = 1e7, p = 1.5, e = 0.5
     /// \[D\]) `height_mm` above the key top.
     pub fn weight(mass_kg: f64, height_mm: f64) -> Self {
         Presser {
@@ -269,7 +270,7 @@ impl Action {
                 &model,
                 "jack",
                 j.stop_angle_rad,
-                f64::INFINITY,
+                j.outer_stop_rad,
                 stop_k,
                 stop_c,
             )?)?;
@@ -375,11 +376,14 @@ impl Action {
                        law: &ContactParams,
                        system: &mut System|
          -> Result<()> {
-            let normal = HuntCrossley::from_restitution(
+            // Felt, cloth and leather lose the same share of energy in a slow settle as in a
+            // hard blow (rate-independent hysteresis, Boutillon 1988; Hirschkorn et al.
+            // 2006): restitution `e` at every speed above the smoothing speed.
+            let normal = HystereticFelt::from_restitution(
                 law.k,
                 law.p,
                 law.e,
-                p.numerics.contact_reference_speed_m_s,
+                p.numerics.felt_smoothing_m_s,
             )?;
             let mut c = Contact::new(&model, name, a, b, normal)?;
             if law.mu > 0.0 {

@@ -406,6 +406,11 @@ fn shapes(p: &ActionParams, r: &mut Report) {
             "jack stop (how far the jack may turn back past its rest angle)",
         ),
         (
+            "jack.outer_stop_rad",
+            p.jack.outer_stop_rad,
+            "jack's outer stop (how far it may turn out from under the knuckle)",
+        ),
+        (
             "repetition_lever.upper_stop_rad",
             p.repetition_lever.upper_stop_rad,
             "repetition lever's upper stop",
@@ -422,6 +427,16 @@ fn shapes(p: &ActionParams, r: &mut Report) {
                 ),
             );
         }
+    }
+    if p.jack.outer_stop_rad <= p.jack.stop_angle_rad.max(0.0) + 0.02 {
+        r.push(
+            "jack.outer_stop_rad",
+            format!(
+                "the jack's outer stop ({} rad) must lie beyond its rest and its inner stop \
+                 ({} rad) by at least 0.02 rad, or the jack cannot escape",
+                p.jack.outer_stop_rad, p.jack.stop_angle_rad
+            ),
+        );
     }
 }
 

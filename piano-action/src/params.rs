@@ -96,6 +96,10 @@ pub struct JackParams {
     pub spring_stiffness_n_m_per_rad: f64,
     /// Jack stop: the jack cannot turn back past this angle from rest (rad).
     pub stop_angle_rad: f64,
+    /// How far the jack can turn out from under the knuckle (rad from rest) before its back
+    /// meets the repetition lever's window or the wippen (absent in older files: 0.3).
+    #[serde(default = "default_jack_outer_stop")]
+    pub outer_stop_rad: f64,
     /// Coulomb friction at the jack centre (N·m).
     pub pivot_friction_n_m: f64,
 }
@@ -200,8 +204,10 @@ pub struct RegulationParams {
     pub backcheck_offset_mm: f64,
 }
 
-/// A felt, cloth or leather contact: Hunt–Crossley `F = k δ^p (1 + 1.5 (1 − e) δ̇ / v_ref)`
-/// and regularised Coulomb friction `μ`.
+/// A felt, cloth or leather contact: rate-independent hysteresis
+/// `F = k δ^p (1 + a tanh(δ̇ / v_s))`, `a = (1 − e²)/(1 + e²)`, so every impact keeps the
+/// restitution `e` (`mbs_contact::laws::HystereticFelt::from_restitution`), and
+/// regularised Coulomb friction `μ`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactParams {
@@ -307,8 +313,9 @@ impl ContactsParams {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NumericsParams {
-    /// Reference speed of the Hunt–Crossley damping (m/s).
-    pub contact_reference_speed_m_s: f64,
+    /// Velocity scale over which a felt contact passes from its unloading to its loading
+    /// branch (m/s): a smoothing of the rate-independent hysteresis, not a material constant.
+    pub felt_smoothing_m_s: f64,
     /// Velocity scale of contact friction (m/s).
     pub friction_regularization_m_s: f64,
     /// Angular velocity scale of pivot friction (rad/s).
@@ -397,8 +404,8 @@ impl ActionParams {
             ("hammer.knuckle_radius_mm", self.hammer.knuckle_radius_mm),
             ("hammer.crown_radius_mm", self.hammer.crown_radius_mm),
             (
-                "numerics.contact_reference_speed_m_s",
-                self.numerics.contact_reference_speed_m_s,
+                "numerics.felt_smoothing_m_s",
+                self.numerics.felt_smoothing_m_s,
             ),
             (
                 "numerics.relative_tolerance",
@@ -491,4 +498,9 @@ fn check_value(path: &str, v: &toml::Value) -> Result<()> {
         }
         _ => Ok(()),
     }
+}
+
+/// The jack's outer stop of files written before it existed (rad) \[M\].
+fn default_jack_outer_stop() -> f64 {
+    0.3
 }

@@ -367,6 +367,7 @@ fn turn_screw(
 ) -> Result<()> {
     let mut x = get(p);
     let mut f = measure(p)?;
+    let mut idle = 0;
     for _ in 0..8 {
         let value = f.unwrap_or(0.0);
         if f.is_some() && (value - target).abs() <= tol {
@@ -377,6 +378,17 @@ fn turn_screw(
         set(&mut q, x + dx);
         let fq = measure(&q)?;
         if let (Some(a), Some(b)) = (f, fq) {
+            // A screw that no longer acts (the simplified action's key blocked by the
+            // hammer on the string before it reaches a lowered punching) is not turned
+            // out of the action: two moves in a row without effect end the search.
+            if (b - a).abs() < 0.1 * (slope * dx).abs() {
+                idle += 1;
+                if idle >= 2 {
+                    return Ok(());
+                }
+            } else {
+                idle = 0;
+            }
             let secant = (b - a) / dx;
             // Keep the expected sign and a sane size; felt and contact switching make
             // single differences noisy.

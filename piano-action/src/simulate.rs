@@ -85,7 +85,7 @@ pub struct Finger {
     pub rise_s: f64,
     /// Viscous coupling of the arm driving a struck finger (N·s/m).
     pub arm_damping_n_s_m: f64,
-    /// Pulp of the fingertip against the key top (Hunt–Crossley, soft and lossy).
+    /// Pulp of the fingertip against the key top (a soft, lossy felt-type law).
     pub pad: ContactParams,
 }
 
