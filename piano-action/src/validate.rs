@@ -192,6 +192,8 @@ pub struct Validation {
     pub rows: Vec<Row>,
     /// The touches from soft to loud behind the rows, for the page's plots.
     pub curves: Curves,
+    /// Whether known deviations were applied and some are listed for this model.
+    pub known_listed: bool,
 }
 
 /// One entry of the known-deviations file.
@@ -281,6 +283,7 @@ impl Validation {
     /// model (rows in band keep `None`: see [`Validation::stale`]).
     pub fn apply_known(&mut self, known: &[KnownDeviation]) {
         let name = self.model.name();
+        self.known_listed = known.iter().any(|d| d.models.iter().any(|m| m == name));
         for row in &mut self.rows {
             row.known_deviation = if row.in_band {
                 None
@@ -334,10 +337,17 @@ impl Validation {
     /// The count line under the tables.
     pub fn summary(&self) -> String {
         let (n, inside, known, unlisted) = self.counts();
-        format!(
+        let mut s = format!(
             "{n} rows: {inside} in band, {} out of band ({known} known deviations, {unlisted} not listed)",
             known + unlisted
-        )
+        );
+        if !self.known_listed {
+            s.push_str(&format!(
+                "; no known deviations are listed for the {} action",
+                self.model.name()
+            ));
+        }
+        s
     }
 
     /// The terminal table: aligned columns, then the notes and the count line.
@@ -481,6 +491,7 @@ mod tests {
                 Row::new("c", "none", None, Band::Range(0.0, 2.0), "mm", "s").note("why"),
             ],
             curves: Curves::default(),
+            known_listed: false,
         }
     }
 
@@ -574,6 +585,10 @@ mod tests {
         let col = |l: &str| l.find("mm").unwrap();
         assert!(lines.iter().all(|l| col(l) == col(lines[0])), "{t}");
         assert!(t.contains("3 rows: 1 in band, 2 out of band"), "{t}");
+        assert!(
+            t.contains("no known deviations are listed for the double action"),
+            "{t}"
+        );
         assert!(t.contains("c: why"), "{t}");
     }
 }

@@ -79,6 +79,7 @@ pub fn validate(params: &ActionParams, kind: ModelKind) -> Result<Validation> {
         model: kind,
         rows,
         curves,
+        known_listed: false,
     })
 }
 
@@ -472,7 +473,7 @@ fn mass_drop_rows(params: &ActionParams, kind: ModelKind) -> Vec<Row> {
             "mm",
             "lit. §2; layout §6 (Bullock) [V]",
         )
-        .literature("9.5..12 (dip + punching)"),
+        .literature("9.5..12"),
     ];
     failed(rows, &outcome)
 }

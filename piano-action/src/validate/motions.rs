@@ -118,7 +118,10 @@ fn motion_strikes(
 }
 
 /// The motion families: (id, description, profile and speed of each run).
-fn motion_families() -> Vec<(&'static str, &'static str, Vec<(Profile, f64)>)> {
+/// A family of motions: id, description, and the profile and speed of each run.
+type Family = (&'static str, &'static str, Vec<(Profile, f64)>);
+
+fn motion_families() -> Vec<Family> {
     let every = |p: Profile| MOTION_SPEEDS.iter().map(|&v| (p, v)).collect::<Vec<_>>();
     // Ramps of 5, 15 and 30 ms, where the constant speed is reached within half the dip.
     let ramps = [5e-3, 15e-3, 30e-3]
@@ -137,7 +140,7 @@ fn motion_families() -> Vec<(&'static str, &'static str, Vec<(Profile, f64)>)> {
             "minimum-jerk motions",
             every(Profile::MinimumJerk),
         ),
-        ("ramp", "5-30 ms ramps to a speed", ramps),
+        ("ramp", "ramps of 5-30 ms", ramps),
     ]
 }
 
@@ -209,7 +212,7 @@ pub(super) fn motion_rows(params: &ActionParams, kind: ModelKind) -> Vec<Row> {
         }
         let row = Row::new(
             format!("motion.{id}"),
-            format!("{what} 0.1-1 m/s: not one strike"),
+            format!("{what}, 0.1-1 m/s: not 1 strike"),
             error.is_none().then_some(bad.len() as f64),
             Band::Exactly(0.0),
             "runs",
@@ -331,9 +334,9 @@ pub(super) fn control_rows(params: &ActionParams, kind: ModelKind) -> Vec<Row> {
                 value,
                 Band::AtLeast(1.0),
                 "runs",
-                "upright layout §8.4 (Sykes, Bremmer) [V]",
+                "upright layout §8.4 (Sykes) [V]",
             )
-            .literature(">= 1 (double strike/block)")
+            .literature(">= 1")
             .decimals(0)
             .note(note),
         ]

@@ -7,7 +7,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::svg::{Axis, Chart, Mark, Series, escape};
+use super::svg::{Axis, Chart, Corner, Mark, Series, escape};
 use super::touches::{
     Blow, CONTACT_REFERENCE, DYNAMICS, KEY_BOTTOM_REFERENCE, Touch, goebl_travel_time_s,
 };
@@ -88,8 +88,10 @@ fn cell(text: &str) -> String {
 pub fn markdown(v: &Validation) -> String {
     let mut s = format!(
         "{}\n# Validation of the {} action against the literature\n\n\
-         Written by `piano validate --out DIR`; the bands and their sources are in \
-         `docs/reference` (`literature.md`, `string_reference.md`), the known deviations in \
+         Written by `piano validate --out DIR`. Each row runs an experiment of \
+         `literature.md` or `string_reference.md` on the model; the source column names the \
+         section and its tag ([V] read, [S] secondhand, [M] recalled, [D] derived). The \
+         known deviations and their reasons are in \
          `piano-action/validation/known_deviations.toml`.\n\n{}.\n\n",
         generator_mark("validation.md"),
         v.model.name(),
@@ -333,36 +335,42 @@ pub fn charts(v: &Validation) -> Vec<Chart> {
             x: speed_axis(),
             y: Axis::log(10.0, 500.0, "travel time (ms)"),
             series: travel,
+            legend: Corner::BottomLeft,
         },
         Chart {
             title: "Hammer-string contact duration".into(),
             x: speed_axis(),
             y: Axis::linear(0.0, 4.0, "contact duration (ms)"),
             series: contact,
+            legend: Corner::TopRight,
         },
         Chart {
             title: "Hammer rebound e = -v_out / v_in".into(),
             x: speed_axis(),
             y: Axis::linear(0.0, 1.2, "e"),
             series: rebound,
+            legend: Corner::TopRight,
         },
         Chart {
             title: "Check distance, key held".into(),
             x: speed_axis(),
             y: Axis::linear(0.0, 30.0, "crown to string (mm)"),
             series: check,
+            legend: Corner::TopRight,
         },
         Chart {
             title: "Key bottom minus string contact".into(),
             x: speed_axis(),
             y: Axis::linear(-10.0, 40.0, "key bottom - string contact (ms)"),
             series: key_bottom,
+            legend: Corner::TopRight,
         },
         Chart {
             title: "Free flight after let-off".into(),
             x: speed_axis(),
-            y: Axis::linear(0.0, 3.0, "crown to string at jack release (mm)"),
+            y: Axis::linear(0.0, 8.0, "crown to string at jack release (mm)"),
             series: free_flight,
+            legend: Corner::TopRight,
         },
     ]
 }
@@ -372,9 +380,9 @@ h1{font-size:22px}h2{font-size:18px;margin-top:28px}\
 table{border-collapse:collapse;font-size:13px}\
 th,td{border-bottom:1px solid #ddd;padding:4px 8px;text-align:left;vertical-align:top}\
 th{background:#f4f4f4}td.num{text-align:right;font-variant-numeric:tabular-nums}\
-td.in{color:#1e7b3c}td.known{color:#b9770e;font-weight:bold}td.out{color:#c0392b;font-weight:bold}\
+td.nowrap{white-space:nowrap}td.in{color:#1e7b3c}td.known{color:#b9770e;font-weight:bold}td.out{color:#c0392b;font-weight:bold}\
 .note{color:#777;font-size:11px}code{font-size:12px}\
-.charts{display:flex;flex-wrap:wrap;gap:12px}.charts svg{border:1px solid #ddd}\
+.charts{display:flex;flex-wrap:wrap;gap:12px}.charts svg{border:1px solid #ddd;flex:1 1 520px;max-width:620px;height:auto}\
 dl dt{font-weight:bold;margin-top:8px}dl dd{margin-left:16px}";
 
 /// The self-contained HTML page: the table, the plots, the known deviations.
@@ -415,7 +423,7 @@ pub fn html(v: &Validation) -> String {
         });
         let _ = writeln!(
             s,
-            "<tr><td><code>{}</code></td><td>{}{note}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td></tr>",
+            "<tr><td><code>{}</code></td><td>{}{note}</td><td class=\"num\">{}</td><td class=\"nowrap\">{}</td><td>{}</td><td>{}</td><td class=\"{class} nowrap\">{}</td></tr>",
             escape(&r.id),
             escape(&r.quantity),
             escape(&r.value_text()),
@@ -468,6 +476,7 @@ mod tests {
                 Row::new("c", "<z>", Some(3.0), Band::Range(0.0, 2.0), "mm", "s"),
             ],
             curves: Curves::default(),
+            known_listed: true,
         };
         v.rows[1].known_deviation = Some("because".into());
         v

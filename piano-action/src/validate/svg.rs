@@ -123,6 +123,15 @@ pub struct Series {
     pub mark: Mark,
 }
 
+/// Where the legend goes inside the plot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Corner {
+    /// Top right.
+    TopRight,
+    /// Bottom left.
+    BottomLeft,
+}
+
 /// A chart: title, axes and series.
 #[derive(Clone, Debug)]
 pub struct Chart {
@@ -134,6 +143,8 @@ pub struct Chart {
     pub y: Axis,
     /// What is drawn, first at the back.
     pub series: Vec<Series>,
+    /// Where the legend goes.
+    pub legend: Corner,
 }
 
 const WIDTH: f64 = 620.0;
@@ -327,7 +338,7 @@ impl Chart {
         }
     }
 
-    /// The legend, top right inside the plot: one line per labelled series.
+    /// The legend inside the plot, in its corner: one line per labelled series.
     fn legend(&self, s: &mut String) {
         let labelled: Vec<&Series> = self.series.iter().filter(|x| !x.label.is_empty()).collect();
         if labelled.is_empty() {
@@ -340,8 +351,10 @@ impl Chart {
             .unwrap_or(0) as f64;
         let w = 36.0 + 6.6 * longest;
         let h = 8.0 + 18.0 * labelled.len() as f64;
-        let x = WIDTH - RIGHT - w - 8.0;
-        let y = TOP + 8.0;
+        let (x, y) = match self.legend {
+            Corner::TopRight => (WIDTH - RIGHT - w - 8.0, TOP + 8.0),
+            Corner::BottomLeft => (LEFT + 8.0, HEIGHT - BOTTOM - h - 8.0),
+        };
         let _ = write!(
             s,
             r##"<rect x="{x:.1}" y="{y:.1}" width="{w:.1}" height="{h:.1}" fill="white" fill-opacity="0.9" stroke="#bbb"/>"##
@@ -421,6 +434,7 @@ mod tests {
                 points: vec![(0.0, 1.0), (0.5, 10.0), (1.0, -1.0)],
                 mark: Mark::Line { dashed: false },
             }],
+            legend: Corner::TopRight,
         };
         let svg = c.svg();
         assert!(svg.starts_with("<svg") && svg.ends_with("</svg>"));

@@ -362,19 +362,20 @@ pub(super) fn touch_experiments(
             .collect()
     };
     let (struck, pressed) = rayon::join(|| sweep(Touch::Struck), || sweep(Touch::Pressed));
-    // Every hammer speed a row needs, per touch.
-    let mut struck_targets: Vec<f64> = vec![0.5, 1.0, 2.0, 3.5, 4.0, 5.0, 2.5, 5.5];
+    // Every hammer speed a row needs: the dynamic levels for both touches, and for struck
+    // ones the contact reference and free flight speeds.
+    let pressed_targets: Vec<f64> = DYNAMICS.iter().map(|d| d.1).collect();
+    let mut struck_targets = pressed_targets.clone();
     struck_targets.extend(CONTACT_REFERENCE.iter().map(|c| c.0));
     struck_targets.extend(FREE_FLIGHT_SPEEDS);
     struck_targets.sort_by(f64::total_cmp);
     struck_targets.dedup();
-    let pressed_targets = [0.5, 1.0, 2.5, 4.0, 5.5];
     let jobs: Vec<(Touch, f64)> = struck_targets
         .iter()
         .map(|&v| (Touch::Struck, v))
         .chain(pressed_targets.iter().map(|&v| (Touch::Pressed, v)))
         .collect();
-    let found: Vec<((Touch, f64), std::result::Result<Blow, String>)> = jobs
+    let found: Vec<Matched> = jobs
         .par_iter()
         .map(|&(touch, v)| {
             let sweep = if touch == Touch::Struck {
@@ -394,9 +395,8 @@ pub(super) fn touch_experiments(
                 |(_, r)| r.as_ref().map_err(Clone::clone),
             )
     };
-    let mut rows = Vec::new();
-
     // Velocity range: the softest and loudest touches.
+    let mut velocity = Vec::new();
     for (touch, sweep) in [(Touch::Pressed, &pressed), (Touch::Struck, &struck)] {
         for (end, dynamic, band) in [
             (sweep.first(), "pp", Band::Range(0.3, 1.0)),
@@ -422,10 +422,10 @@ pub(super) fn touch_experiments(
                         .unwrap_or_else(|| "the hammer did not reach the string".to_string()),
                 );
             }
-            rows.push(row);
+            velocity.push(row);
         }
     }
-    let velocity = std::mem::take(&mut rows);
+    let mut rows = Vec::new();
 
     // Free flight from let-off to the string.
     for v in FREE_FLIGHT_SPEEDS {
@@ -437,8 +437,9 @@ pub(super) fn touch_experiments(
                 b.as_ref().ok().and_then(|b| b.free_flight_mm),
                 Band::Range(0.5, 2.0),
                 "mm",
-                "lit. §2 (Gillespie 2011: 1-1.5) [V]",
-            ),
+                "lit. §2 (Gillespie 2011) [V]",
+            )
+            .literature("0.5..2 (measured 1-1.5)"),
             &b,
         ));
     }
@@ -600,13 +601,12 @@ pub(super) fn touch_experiments(
     )
 }
 
+/// A touch matched to a hammer speed: (touch, target m/s), and the blow or why none.
+type Matched = ((Touch, f64), std::result::Result<Blow, String>);
+
 /// The worst relative deviation (%) from Goebl's travel-time law of the touches of `touch`
 /// (sweep and matched) that give 1 to 5 m/s.
-fn goebl_row(
-    touch: Touch,
-    sweep: &[Blow],
-    found: &[((Touch, f64), std::result::Result<Blow, String>)],
-) -> Row {
+fn goebl_row(touch: Touch, sweep: &[Blow], found: &[Matched]) -> Row {
     let in_range: Vec<&Blow> = sweep
         .iter()
         .chain(
@@ -626,7 +626,7 @@ fn goebl_row(
         .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()));
     let row = Row::new(
         format!("travel_time.{}_vs_goebl", touch.name()),
-        format!("travel time, {} 1-5 m/s: worst deviation", touch.name()),
+        format!("travel time, {} 1-5 m/s, worst", touch.name()),
         worst.map(|w| w.2),
         Band::Range(-25.0, 25.0),
         "%",
