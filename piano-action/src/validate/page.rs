@@ -368,7 +368,7 @@ pub fn charts(v: &Validation) -> Vec<Chart> {
         Chart {
             title: "Free flight after let-off".into(),
             x: speed_axis(),
-            y: Axis::linear(0.0, 8.0, "crown to string at jack release (mm)"),
+            y: Axis::linear(0.0, 12.0, "crown to string at jack release (mm)"),
             series: free_flight,
             legend: Corner::TopRight,
         },
