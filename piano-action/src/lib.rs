@@ -15,7 +15,7 @@
 //! ([`touchweight::measure`]); the hammer swing test ([`pendulum`]); scenarios and run
 //! directories with drawings to scale ([`scenario`], [`drawing`]); parallel sweeps over
 //! touch levels ([`sweep`]); the interactive HTML report ([`report`]) and static figures
-//! ([`plot`]).
+//! ([`plot`]); the validation against the literature ([`validate`]).
 //!
 #![warn(missing_docs)]
 
@@ -36,6 +36,7 @@ pub mod simulate;
 pub mod sweep;
 pub mod toml_lines;
 pub mod touchweight;
+pub mod validate;
 
 pub use action::{Action, ModelKind, Presser};
 pub use drawing::action_svg;

@@ -95,6 +95,25 @@ enum Command {
     /// Play one keystroke per level, in parallel on all cores, and write one CSV row per
     /// run (hammer speed, string contact, travel time, key bottom, check, ...).
     Sweep(SweepArgs),
+    /// Run every literature experiment the model can reproduce (regulation, touchweight,
+    /// touches from pp to ff, string contact, key motions, repetition, the 1 kg drop, the
+    /// swing test) and print one table: model value, literature band, source, in or out of
+    /// band, and whether an out-of-band row is a known deviation.
+    Validate {
+        /// Which model.
+        #[arg(long, default_value = "double")]
+        model: String,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Also write DIR/validation.md (the table) and DIR/validation.html (the table and
+        /// plots over the published points); the folder is created if missing.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+        /// Replace validation.md and validation.html written by an earlier run.
+        #[arg(long)]
+        force: bool,
+    },
     /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
     /// from a slow simulated key descent and ascent.
     Touchweight {
@@ -454,6 +473,39 @@ fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), Str
     Ok(())
 }
 
+fn validate(
+    params: &ActionParams,
+    model: &str,
+    json: bool,
+    out: Option<&std::path::Path>,
+    force: bool,
+) -> Result<(), String> {
+    use piano_action::validate::{page, validate_with_known};
+    let kind = model_kind(model)?;
+    if let Some(dir) = out {
+        page::check_out_dir(dir, force).map_err(|e| e.to_string())?;
+    }
+    let v = with_spinner("running the validation experiments", || {
+        validate_with_known(params, kind)
+    })
+    .map_err(|e| e.to_string())?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&v.to_json()).map_err(|e| e.to_string())?
+        );
+    } else {
+        print!("{}", v.table());
+    }
+    if let Some(dir) = out {
+        let written = page::write_pages(&v, dir, force).map_err(|e| e.to_string())?;
+        for path in written {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
 fn regulate(
     params: &ActionParams,
     model: &str,
@@ -668,6 +720,12 @@ fn main() -> ExitCode {
         _ => load(cli.params.as_deref()).and_then(|params| match command {
             Command::Demo => demo(&params),
             Command::Touchweight { model, json } => touchweight(&params, &model, json),
+            Command::Validate {
+                model,
+                json,
+                out,
+                force,
+            } => validate(&params, &model, json, out.as_deref(), force),
             Command::Regulate { model, json, write } => {
                 regulate(&params, &model, json, write.as_deref())
             }
