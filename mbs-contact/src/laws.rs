@@ -17,6 +17,14 @@ pub trait NormalLaw: Send + Sync + std::fmt::Debug {
     /// The normal force (N, ≥ 0). `states` are the law's internal states; their rates are
     /// written into `rates` (same length), also when out of contact (memory relaxes).
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64;
+
+    /// The tangent stiffness `∂F/∂δ` (N/m) at fixed `delta_dot` and states, when the law
+    /// knows it in closed form; `None` (the default) when it does not, and callers that
+    /// need it (the series felt–string spring of [`crate::StringContact`]) then take a
+    /// finite difference of [`NormalLaw::force`].
+    fn tangent_stiffness(&self, _delta: f64, _delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        None
+    }
 }
 
 /// A tangential (friction) law: the friction force opposing the slip velocity, given the
@@ -81,6 +89,10 @@ impl<L: NormalLaw + ?Sized> NormalLaw for Box<L> {
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64 {
         (**self).force(delta, delta_dot, states, rates)
     }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        (**self).tangent_stiffness(delta, delta_dot, states)
+    }
 }
 
 impl<L: NormalLaw + ?Sized> NormalLaw for std::sync::Arc<L> {
@@ -90,6 +102,10 @@ impl<L: NormalLaw + ?Sized> NormalLaw for std::sync::Arc<L> {
 
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64 {
         (**self).force(delta, delta_dot, states, rates)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        (**self).tangent_stiffness(delta, delta_dot, states)
     }
 }
 
@@ -150,6 +166,12 @@ impl NormalLaw for KelvinVoigt {
             return 0.0;
         }
         (self.stiffness * delta + self.damping * delta_dot).max(0.0)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = k where the force is positive.
+        let active = delta > 0.0 && self.stiffness * delta + self.damping * delta_dot > 0.0;
+        Some(if active { self.stiffness } else { 0.0 })
     }
 }
 
@@ -227,6 +249,14 @@ impl NormalLaw for Hertz {
             return 0.0;
         }
         self.stiffness * power(delta, self.exponent)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, _delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = n k δⁿ⁻¹
+        if delta <= 0.0 {
+            return Some(0.0);
+        }
+        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta)
     }
 }
 
@@ -371,6 +401,15 @@ impl NormalLaw for HuntCrossley {
         }
         (self.stiffness * power(delta, self.exponent) * (1.0 + 1.5 * self.alpha * delta_dot))
             .max(0.0)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = n k δⁿ⁻¹ (1 + (3/2) α δ̇) where the force is positive.
+        let damping = 1.0 + 1.5 * self.alpha * delta_dot;
+        if delta <= 0.0 || damping <= 0.0 {
+            return Some(0.0);
+        }
+        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta * damping)
     }
 }
 
