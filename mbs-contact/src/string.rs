@@ -592,6 +592,13 @@ impl StringContact {
         element.as_any()?.downcast_ref::<StringContact>()
     }
 
+    /// The gap (m) between the striker and the string *at rest* at the state in `ctx`: the
+    /// distance a technician measures to the string line (blow distance, check), free of
+    /// the string's ringing. The felt's own gap is in [`StringContact::output`].
+    pub fn rest_gap(&self, ctx: &ForceContext<'_>) -> f64 {
+        self.rigid_proximity(ctx).gap
+    }
+
     /// Proximity of the string at rest (A) and the striker (B), world coordinates.
     fn rigid_proximity(&self, ctx: &ForceContext<'_>) -> Proximity {
         let pose = ctx.body_pose(self.striker.body);

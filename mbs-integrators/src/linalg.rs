@@ -7,6 +7,10 @@ pub(crate) struct Lu {
     n: usize,
     a: Vec<f64>,
     piv: Vec<usize>,
+    /// Whether column k of L (below the diagonal) has a non-zero entry.
+    l_used: Vec<bool>,
+    /// Whether column k of U (above the diagonal) has a non-zero entry.
+    u_used: Vec<bool>,
 }
 
 impl Lu {
@@ -15,6 +19,8 @@ impl Lu {
             n,
             a: vec![0.0; n * n],
             piv: vec![0; n],
+            l_used: vec![true; n],
+            u_used: vec![true; n],
         }
     }
 
@@ -57,14 +63,22 @@ impl Lu {
             for i in k + 1..n {
                 a[i + n * k] *= inv;
             }
-            for j in k + 1..n {
-                let akj = a[k + n * j];
-                if akj != 0.0 {
-                    for i in k + 1..n {
-                        a[i + n * j] -= a[i + n * k] * akj;
+            // Rows and columns that are those of the identity (states the Jacobian leaves
+            // out) cost no elimination: zero multipliers are skipped.
+            self.l_used[k] = a[k + 1 + n * k..n + n * k].iter().any(|v| *v != 0.0);
+            if self.l_used[k] {
+                for j in k + 1..n {
+                    let akj = a[k + n * j];
+                    if akj != 0.0 {
+                        for i in k + 1..n {
+                            a[i + n * j] -= a[i + n * k] * akj;
+                        }
                     }
                 }
             }
+        }
+        for k in 0..n {
+            self.u_used[k] = a[n * k..k + n * k].iter().any(|v| *v != 0.0);
         }
         true
     }
@@ -78,15 +92,19 @@ impl Lu {
         }
         for k in 0..n {
             let bk = b[k];
-            for i in k + 1..n {
-                b[i] -= a[i + n * k] * bk;
+            if self.l_used[k] && bk != 0.0 {
+                for i in k + 1..n {
+                    b[i] -= a[i + n * k] * bk;
+                }
             }
         }
         for k in (0..n).rev() {
             b[k] /= a[k + n * k];
             let bk = b[k];
-            for i in 0..k {
-                b[i] -= a[i + n * k] * bk;
+            if self.u_used[k] && bk != 0.0 {
+                for i in 0..k {
+                    b[i] -= a[i + n * k] * bk;
+                }
             }
         }
     }
