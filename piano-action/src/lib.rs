@@ -38,7 +38,7 @@ pub mod toml_lines;
 pub mod touchweight;
 pub mod validate;
 
-pub use action::{Action, ModelKind, Presser};
+pub use action::{Action, ContactElement, ModelKind, Presser};
 pub use drawing::action_svg;
 pub use error::{InputError, InputKind, PianoError, Result};
 pub use params::ActionParams;

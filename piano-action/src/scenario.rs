@@ -726,6 +726,7 @@ pub fn write_run_dir(
                 "time_s": s.time_s,
                 "hammer_velocity_m_s": s.hammer_velocity_m_s,
                 "contact_duration_s": num(s.contact_duration_s),
+                "rebound_velocity_m_s": num(s.rebound_velocity_m_s),
             })
         })
         .collect();

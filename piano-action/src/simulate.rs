@@ -417,6 +417,9 @@ pub struct Strike {
     pub hammer_velocity_m_s: f64,
     /// How long the felt stays on the string (s); `None` if the run ends in contact.
     pub contact_duration_s: Option<f64>,
+    /// Speed of the strike point leaving the string (m/s, away from it); `None` if the run
+    /// ends in contact. Over the strike speed it is the restitution the string gives.
+    pub rebound_velocity_m_s: Option<f64>,
 }
 
 /// The result of a keystroke.
@@ -762,11 +765,14 @@ pub fn simulate_observed(
                             time_s: ev.time,
                             hammer_velocity_m_s: ev.state[nv + hammer].abs() * strike_radius,
                             contact_duration_s: None,
+                            rebound_velocity_m_s: None,
                         });
                     } else if let Some(s) = strikes.last_mut()
                         && s.contact_duration_s.is_none()
                     {
                         s.contact_duration_s = Some(ev.time - s.time_s);
+                        // The hammer turns away from the string: a negative rate.
+                        s.rebound_velocity_m_s = Some(-ev.state[nv + hammer] * strike_radius);
                     }
                 }
             }
