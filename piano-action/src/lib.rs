@@ -42,4 +42,6 @@ pub use action::{Action, ContactElement, ModelKind, Presser};
 pub use drawing::action_svg;
 pub use error::{InputError, InputKind, PianoError, Result};
 pub use params::ActionParams;
-pub use simulate::{BLOW_PULSE_GAP_S, Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate};
+pub use simulate::{
+    BLOW_PULSE_GAP_S, Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate,
+};

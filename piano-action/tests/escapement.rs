@@ -170,4 +170,3 @@ fn a_let_off_regulated_too_close_to_the_string_strikes_twice() {
     let once = strikes(&ActionParams::reference(), constant_speed(0.1, 5e-3));
     assert_eq!(once.strikes.len(), 1);
 }
-
