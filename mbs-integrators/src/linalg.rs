@@ -118,6 +118,8 @@ pub(crate) struct IterationMatrix {
     /// The active block `J_AA`, column-major, then work space for a solve.
     block: Vec<f64>,
     work: Vec<f64>,
+    /// Whether the Jacobian changed since `active` was found.
+    stale: bool,
 }
 
 impl IterationMatrix {
@@ -130,20 +132,30 @@ impl IterationMatrix {
             coupling: Vec::new(),
             block: vec![0.0; n * n],
             work: vec![0.0; n],
+            stale: true,
         }
+    }
+
+    /// Tells the matrix that the Jacobian changed: its zero columns are looked for again at
+    /// the next factorisation.
+    pub fn jacobian_changed(&mut self) {
+        self.stale = true;
     }
 
     /// Factors `I − c J` (J column-major, n × n). Returns false when singular.
     pub fn factor_shifted(&mut self, c: f64, jac: &[f64]) -> bool {
         let n = self.n;
-        self.active.clear();
-        self.passive.clear();
-        for j in 0..n {
-            if jac[n * j..n * (j + 1)].iter().any(|v| *v != 0.0) {
-                self.active.push(j);
-            } else {
-                self.passive.push(j);
+        if self.stale {
+            self.active.clear();
+            self.passive.clear();
+            for j in 0..n {
+                if jac[n * j..n * (j + 1)].iter().any(|v| *v != 0.0) {
+                    self.active.push(j);
+                } else {
+                    self.passive.push(j);
+                }
             }
+            self.stale = false;
         }
         let na = self.active.len();
         if self.lu.n != na {
@@ -240,6 +252,7 @@ mod tests {
         }
         // A full Jacobian again: every state active.
         let full: Vec<f64> = (0..n * n).map(|k| 0.1 * (k as f64 + 1.0)).collect();
+        w.jacobian_changed();
         assert!(w.factor_shifted(c, &full));
         assert_eq!(w.active.len(), n);
     }

@@ -188,6 +188,7 @@ impl TrBdf2 {
         }
         self.jac_valid = true;
         self.jac_fresh = true;
+        self.lu.jacobian_changed();
         self.lu_c = f64::NAN;
         Ok(())
     }
