@@ -46,9 +46,9 @@ impl ContactSide {
 
 /// A side resolved on a model: body and shapes in the body's joint frame.
 #[derive(Clone, Debug)]
-struct ResolvedSide {
-    body: BodyId,
-    shapes: Vec<Shape>,
+pub(crate) struct ResolvedSide {
+    pub(crate) body: BodyId,
+    pub(crate) shapes: Vec<Shape>,
 }
 
 /// What a contact does at one state.
@@ -275,7 +275,7 @@ impl Contact {
     }
 }
 
-fn resolve(model: &Model, contact: &str, side: &ContactSide) -> Result<ResolvedSide> {
+pub(crate) fn resolve(model: &Model, contact: &str, side: &ContactSide) -> Result<ResolvedSide> {
     if side.shapes.is_empty() {
         return Err(ContactError::UnsupportedPair {
             contact: contact.into(),
@@ -296,7 +296,7 @@ fn resolve(model: &Model, contact: &str, side: &ContactSide) -> Result<ResolvedS
 }
 
 /// World velocity of the material point of `body` at the world point `p`.
-fn velocity_at(ctx: &ForceContext<'_>, body: BodyId, p: [f64; 2]) -> [f64; 2] {
+pub(crate) fn velocity_at(ctx: &ForceContext<'_>, body: BodyId, p: [f64; 2]) -> [f64; 2] {
     let p_b = ctx.body_pose(body).inverse_transform_point(p);
     ctx.point_velocity(body, p_b)
 }

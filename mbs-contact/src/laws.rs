@@ -17,6 +17,20 @@ pub trait NormalLaw: Send + Sync + std::fmt::Debug {
     /// The normal force (N, ≥ 0). `states` are the law's internal states; their rates are
     /// written into `rates` (same length), also when out of contact (memory relaxes).
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64;
+
+    /// The tangent stiffness `∂F/∂δ` (N/m) at fixed `delta_dot` and states, when the law
+    /// knows it in closed form; `None` (the default) when it does not, and callers that
+    /// need it (the series felt–string spring of [`crate::StringContact`]) then take a
+    /// finite difference of [`NormalLaw::force`].
+    fn tangent_stiffness(&self, _delta: f64, _delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        None
+    }
+
+    /// Whether the force ignores `delta_dot` (a purely elastic law such as [`Hertz`]).
+    /// `false` by default: the law may depend on the rate.
+    fn rate_independent(&self) -> bool {
+        false
+    }
 }
 
 /// A tangential (friction) law: the friction force opposing the slip velocity, given the
@@ -81,6 +95,14 @@ impl<L: NormalLaw + ?Sized> NormalLaw for Box<L> {
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64 {
         (**self).force(delta, delta_dot, states, rates)
     }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        (**self).tangent_stiffness(delta, delta_dot, states)
+    }
+
+    fn rate_independent(&self) -> bool {
+        (**self).rate_independent()
+    }
 }
 
 impl<L: NormalLaw + ?Sized> NormalLaw for std::sync::Arc<L> {
@@ -90,6 +112,14 @@ impl<L: NormalLaw + ?Sized> NormalLaw for std::sync::Arc<L> {
 
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64 {
         (**self).force(delta, delta_dot, states, rates)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        (**self).tangent_stiffness(delta, delta_dot, states)
+    }
+
+    fn rate_independent(&self) -> bool {
+        (**self).rate_independent()
     }
 }
 
@@ -150,6 +180,12 @@ impl NormalLaw for KelvinVoigt {
             return 0.0;
         }
         (self.stiffness * delta + self.damping * delta_dot).max(0.0)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = k where the force is positive.
+        let active = delta > 0.0 && self.stiffness * delta + self.damping * delta_dot > 0.0;
+        Some(if active { self.stiffness } else { 0.0 })
     }
 }
 
@@ -227,6 +263,18 @@ impl NormalLaw for Hertz {
             return 0.0;
         }
         self.stiffness * power(delta, self.exponent)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, _delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = n k δⁿ⁻¹
+        if delta <= 0.0 {
+            return Some(0.0);
+        }
+        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta)
+    }
+
+    fn rate_independent(&self) -> bool {
+        true
     }
 }
 
@@ -371,6 +419,15 @@ impl NormalLaw for HuntCrossley {
         }
         (self.stiffness * power(delta, self.exponent) * (1.0 + 1.5 * self.alpha * delta_dot))
             .max(0.0)
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = n k δⁿ⁻¹ (1 + (3/2) α δ̇) where the force is positive.
+        let damping = 1.0 + 1.5 * self.alpha * delta_dot;
+        if delta <= 0.0 || damping <= 0.0 {
+            return Some(0.0);
+        }
+        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta * damping)
     }
 }
 

@@ -11,7 +11,10 @@
 //!   hysteretic power-law felt, Stulov's hereditary felt) and friction laws;
 //! - [`materials`]: presets with their sources;
 //! - [`Contact`]: a force element for `mbs_core::System`, mapping contact forces to the
-//!   bodies, with the gap as switching function for event location.
+//!   bodies, with the gap as switching function for event location;
+//! - [`string`]: a taut stiff string reduced to its modes ([`TautString`]) and
+//!   [`StringContact`], a felt-covered striker against it (the hammer on a piano string),
+//!   whose contact duration and rebound follow from the string's motion.
 
 #![warn(missing_docs)]
 
@@ -20,7 +23,9 @@ mod error;
 pub mod geometry;
 pub mod laws;
 pub mod materials;
+pub mod string;
 
 pub use element::{Contact, ContactOutput, ContactSide};
 pub use error::{ContactError, Result};
 pub use geometry::{ArcSide, Proximity, Shape, proximity};
+pub use string::{BridgeForceRenderer, StringContact, StringOutput, StringSpec, TautString};

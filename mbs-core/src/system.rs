@@ -202,6 +202,20 @@ impl System {
         self.entries.get(e).map(|en| en.states.clone())
     }
 
+    /// The ranges of internal states an implicit integrator may leave out of its Jacobian
+    /// ([`ForceElement::states_outside_jacobian`]).
+    pub fn states_outside_jacobian(&self) -> Vec<Range<usize>> {
+        self.entries
+            .iter()
+            .filter_map(|en| {
+                let local = en.element.states_outside_jacobian();
+                let len = en.states.len();
+                let (a, b) = (local.start.min(len), local.end.min(len));
+                (a < b).then(|| en.states.start + a..en.states.start + b)
+            })
+            .collect()
+    }
+
     /// The element and local index of switching function `k`, and its crossing direction.
     pub fn switch_info(&self, k: usize) -> Option<(usize, usize, Crossing)> {
         let e = self

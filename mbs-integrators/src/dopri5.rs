@@ -200,7 +200,7 @@ impl Stepper for Dopri5 {
                 return Ok(());
             }
             let err = if finite {
-                self.ctl.error_norm(&self.err, &self.y, &self.y_new)
+                self.ctl.step_error_norm(&self.err, &self.y, &self.y_new)
             } else {
                 f64::INFINITY
             };

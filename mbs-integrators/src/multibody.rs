@@ -55,6 +55,10 @@ impl OdeSystem for MultibodyOde<'_> {
             .map_err(SystemError::new)
     }
 
+    fn states_outside_jacobian(&self) -> Vec<std::ops::Range<usize>> {
+        self.system.states_outside_jacobian()
+    }
+
     fn second_order_split(&self) -> Option<usize> {
         Some(self.system.model().nv())
     }

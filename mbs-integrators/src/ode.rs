@@ -61,6 +61,14 @@ pub trait OdeSystem {
         Err(SystemError::new("this system has no analytic Jacobian"))
     }
 
+    /// Ranges of states whose Jacobian columns the implicit method may take as zero without
+    /// evaluating them: states whose rates move them only along directions that change no
+    /// rate at a fixed time, so the part of the iteration matrix left out is nilpotent
+    /// (modal amplitudes in variation-of-constants form). None by default.
+    fn states_outside_jacobian(&self) -> Vec<std::ops::Range<usize>> {
+        Vec::new()
+    }
+
     /// For a mechanical system whose state is `y = [q (n), v (n), others]` with `q̇ = v`:
     /// `Some(n)`. Needed by the semi-implicit (symplectic) Euler method.
     fn second_order_split(&self) -> Option<usize> {

@@ -90,6 +90,24 @@ impl Control {
         (s / n).sqrt()
     }
 
+    /// [`Control::error_norm`] of a step from `y0` to `y1`, the mean taken over the
+    /// components that moved or carry an error: states frozen through the step (a
+    /// string's modal amplitudes between strikes) do not dilute the others' error.
+    pub fn step_error_norm(&self, err: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        let mut n = 0usize;
+        let s: f64 = err
+            .iter()
+            .zip(y0.iter().zip(y1))
+            .filter(|(e, (a, b))| **e != 0.0 || a != b)
+            .map(|(e, (a, b))| {
+                n += 1;
+                let sc = self.atol + self.rtol * a.abs().max(b.abs());
+                (e / sc) * (e / sc)
+            })
+            .sum();
+        (s / n.max(1) as f64).sqrt()
+    }
+
     /// Hairer's automatic first step for a method of order `order`.
     pub fn initial_step(
         &self,

@@ -17,7 +17,7 @@
 //! `W⁻¹` (Hosea & Shampine) so it does not overestimate on stiff components.
 
 use crate::error::{IntegratorError, Result};
-use crate::linalg::Lu;
+use crate::linalg::IterationMatrix;
 use crate::ode::OdeSystem;
 use crate::solution::Stats;
 use crate::stepper::{Control, Stepper, clip_step, eval, hermite, non_finite};
@@ -65,7 +65,7 @@ pub(crate) struct TrBdf2 {
     jac_valid: bool,
     /// Whether `jac` was evaluated at the start of the current step.
     jac_fresh: bool,
-    lu: Lu,
+    lu: IterationMatrix,
     /// The `h d` of the current factorisation (NaN when none).
     lu_c: f64,
     /// Which stage the last Newton failure was in.
@@ -104,7 +104,7 @@ impl TrBdf2 {
             jac_tmp: v(),
             jac_valid: false,
             jac_fresh: false,
-            lu: Lu::new(n),
+            lu: IterationMatrix::new(n),
             lu_c: f64::NAN,
             failed_in_end_stage: false,
             slow: false,
@@ -133,7 +133,39 @@ impl TrBdf2 {
                 .map_err(|source| IntegratorError::System { t, source })?;
         } else {
             let mut yp = y.to_vec();
-            for j in 0..self.n {
+            // States the system marks as outside the Jacobian keep zero columns and cost
+            // no evaluation (a string's modal amplitudes, see
+            // `OdeSystem::states_outside_jacobian`).
+            let mut needed = vec![true; self.n];
+            for r in sys.states_outside_jacobian() {
+                for j in r.start.min(self.n)..r.end.min(self.n) {
+                    needed[j] = false;
+                    self.jac.column_mut(j).fill(0.0);
+                }
+            }
+            // The other internal states beyond a mechanical [q, v] (force elements'
+            // memories) are probed together first: when moving them all at once changes no
+            // derivative at all, their columns are zero and their evaluations are saved.
+            let grouped = sys
+                .second_order_split()
+                .map_or(self.n, |nv| (2 * nv).min(self.n));
+            let internal: Vec<usize> = (grouped..self.n).filter(|&j| needed[j]).collect();
+            if internal.len() > 1 {
+                for &j in &internal {
+                    yp[j] = y[j] + f64::EPSILON.sqrt() * y[j].abs().max(1e-5);
+                }
+                if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
+                    return Err(non_finite(t, &self.jac_tmp));
+                }
+                yp[grouped..].copy_from_slice(&y[grouped..]);
+                if self.jac_tmp == f {
+                    for &j in &internal {
+                        needed[j] = false;
+                        self.jac.column_mut(j).fill(0.0);
+                    }
+                }
+            }
+            for j in (0..self.n).filter(|&j| needed[j]) {
                 let yj = y[j];
                 let dj = f64::EPSILON.sqrt() * yj.abs().max(1e-5);
                 yp[j] = yj + dj;
@@ -141,13 +173,14 @@ impl TrBdf2 {
                 if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
                     return Err(non_finite(t, &self.jac_tmp));
                 }
-                for i in 0..self.n {
-                    self.jac[(i, j)] = (self.jac_tmp[i] - f[i]) / dj;
+                let column = self.jac.column_mut(j);
+                for ((out, a), b) in column.into_iter().zip(&self.jac_tmp).zip(f) {
+                    *out = (a - b) / dj;
                 }
                 yp[j] = yj;
             }
         }
-        if self.jac.iter().any(|v| !v.is_finite()) {
+        if self.jac.as_slice().iter().any(|v| !v.is_finite()) {
             return Err(IntegratorError::System {
                 t,
                 source: crate::SystemError::new("the Jacobian has non-finite entries"),
@@ -155,6 +188,7 @@ impl TrBdf2 {
         }
         self.jac_valid = true;
         self.jac_fresh = true;
+        self.lu.jacobian_changed();
         self.lu_c = f64::NAN;
         Ok(())
     }
@@ -216,7 +250,7 @@ impl TrBdf2 {
             for i in 0..self.n {
                 z[i] += self.delta[i];
             }
-            let norm = self.ctl.error_norm(&self.delta, &self.y, z);
+            let norm = self.ctl.step_error_norm(&self.delta, &self.y, z);
             if !norm.is_finite() {
                 return Ok(Stage::Failed);
             }
@@ -369,7 +403,7 @@ impl Stepper for TrBdf2 {
                 self.est[i] = h * (E0 * self.f[i] + E1 * self.f_gamma[i] + E2 * self.f_end[i]);
             }
             self.lu.solve(&mut self.est);
-            let err = self.ctl.error_norm(&self.est, &self.y, &self.z_end);
+            let err = self.ctl.step_error_norm(&self.est, &self.y, &self.z_end);
             // Third-order local error: h_new = h · 0.9 err^(−1/3), within [0.2, 5].
             let mut fac = if err > 0.0 {
                 0.9 * err.powf(-1.0 / 3.0)

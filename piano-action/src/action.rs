@@ -14,14 +14,17 @@
 //! Contacts (rate-independent hysteretic felt laws with regularised Coulomb friction where
 //! μ > 0):
 //! key–front rail, key–back rail, capstan–heel, jack–knuckle, lever–knuckle, jack
-//! toe–let-off button, lever tip–drop screw, tail–backcheck, shank–rest rail,
-//! hammer–string. Springs: repetition and jack springs, with their stops as joint limits.
+//! toe–let-off button, lever tip–drop screw, tail–backcheck, shank–rest rail; and
+//! hammer–string, the crown's felt (C&A power law) against a modal string
+//! ([`mbs_contact::StringContact`], section `[string]` of the parameters), whose internal
+//! states (two per mode) follow the coordinates and velocities in the state.
+//! Springs: repetition and jack springs, with their stops as joint limits.
 //! Pivot friction at every centre.
 
 use std::collections::BTreeMap;
 
-use mbs_contact::laws::{HystereticFelt, RegularizedCoulomb};
-use mbs_contact::{Contact, ContactSide, Shape};
+use mbs_contact::laws::{Hertz, HystereticFelt, RegularizedCoulomb};
+use mbs_contact::{Contact, ContactOutput, ContactSide, Shape, StringContact};
 use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::elements::{FrictionLaw, JointLimit, JointSpringDamper, PivotFriction, SpringLaw};
 use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System, TimeFunction};
@@ -514,13 +517,6 @@ impl Action {
             &c.rest_rail,
             &mut system,
         )?;
-        add(
-            "hammer_string",
-            ContactSide::ground(vec![ground_face(g.string_y_mm, g.string_x_mm, false)?]),
-            ContactSide::on("hammer", vec![crown]),
-            &c.hammer_string,
-            &mut system,
-        )?;
         if let Some(pr) = presser {
             if pr.carried {
                 let weight = AppliedLoad::force(
@@ -548,6 +544,17 @@ impl Action {
                 &mut system,
             )?;
         }
+        // The hammer strikes a modal string lying along the string line (the felt undamped:
+        // the string's motion gives the rebound). Added last: its states end the state.
+        let string = StringContact::new(
+            &model,
+            "hammer_string",
+            p.string.build()?,
+            ground_face(g.string_y_mm, g.string_x_mm, false)?,
+            ContactSide::on("hammer", vec![crown]),
+            Hertz::new(c.hammer_string.k, c.hammer_string.p)?,
+        )?;
+        contacts.insert("hammer_string", system.add_element(string)?);
         Ok(Action {
             kind,
             params: params.clone(),
@@ -682,13 +689,44 @@ impl Action {
         let e = *self.contacts.get(name).ok_or_else(unknown)?;
         let mut ws = self.system.workspace();
         let ctx = self.system.element_context(&mut ws, t, x, e)?;
-        let contact = self
-            .system
-            .elements()
-            .nth(e)
-            .and_then(Contact::of)
-            .ok_or_else(unknown)?;
+        let element = self.system.elements().nth(e).ok_or_else(unknown)?;
+        let contact = ContactElement::of(element).ok_or_else(unknown)?;
         Ok(contact.output(&ctx))
+    }
+
+    /// The string the hammer strikes (its element in the system), if the action has one.
+    pub fn string_contact(&self) -> Option<&StringContact> {
+        let e = *self.contacts.get("hammer_string")?;
+        self.system.elements().nth(e).and_then(StringContact::of)
+    }
+
+    /// The distance (m) from the hammer crown to the string line at rest at time `t` and
+    /// state `x`: what a technician measures (blow distance, check), free of the string's
+    /// ringing; [`Action::gap`] gives the felt's own gap (negative in contact).
+    pub fn string_rest_gap(&self, t: f64, x: &[f64]) -> Result<f64> {
+        let unknown = || mbs_core::CoreError::UnknownName {
+            what: "contact",
+            name: "hammer_string".to_string(),
+        };
+        let e = *self.contacts.get("hammer_string").ok_or_else(unknown)?;
+        let string = self.string_contact().ok_or_else(unknown)?;
+        let mut ws = self.system.workspace();
+        let ctx = self.system.element_context(&mut ws, t, x, e)?;
+        Ok(string.rest_gap(&ctx))
+    }
+
+    /// The string at time `t` and state `x`: displacement and velocity at the strike
+    /// point, bridge force, energy.
+    pub fn string_output(&self, t: f64, x: &[f64]) -> Result<mbs_contact::StringOutput> {
+        let unknown = || mbs_core::CoreError::UnknownName {
+            what: "contact",
+            name: "hammer_string".to_string(),
+        };
+        let e = *self.contacts.get("hammer_string").ok_or_else(unknown)?;
+        let string = self.string_contact().ok_or_else(unknown)?;
+        let mut ws = self.system.workspace();
+        let ctx = self.system.element_context(&mut ws, t, x, e)?;
+        Ok(string.string_output(&ctx))
     }
 
     /// The gap (m) of the named contact at time `t` and state `x` (the time matters when a
@@ -708,5 +746,40 @@ impl Action {
             el.switching_functions(&ctx, &mut g);
         }
         Ok(g[0])
+    }
+}
+
+/// A contact element of the action: a plain [`Contact`] or the hammer on the string
+/// ([`StringContact`]), seen through what drawings and outputs need of both.
+#[derive(Clone, Copy, Debug)]
+pub enum ContactElement<'a> {
+    /// Two shapes and a law.
+    Plain(&'a Contact),
+    /// The hammer crown on the modal string.
+    String(&'a StringContact),
+}
+
+impl<'a> ContactElement<'a> {
+    /// The contact behind a force element, if it is one.
+    pub fn of(element: &'a dyn mbs_core::ForceElement) -> Option<Self> {
+        Contact::of(element)
+            .map(ContactElement::Plain)
+            .or_else(|| StringContact::of(element).map(ContactElement::String))
+    }
+
+    /// The bodies and shapes of the two sides (the string at rest for the string).
+    pub fn sides(&self) -> [(mbs_core::BodyId, &'a [Shape]); 2] {
+        match self {
+            ContactElement::Plain(c) => c.sides(),
+            ContactElement::String(s) => s.sides(),
+        }
+    }
+
+    /// Gap, forces, point and normal at the state in `ctx`.
+    pub fn output(&self, ctx: &mbs_core::ForceContext<'_>) -> ContactOutput {
+        match self {
+            ContactElement::Plain(c) => c.output(ctx),
+            ContactElement::String(s) => s.output(ctx),
+        }
     }
 }

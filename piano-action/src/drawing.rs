@@ -21,10 +21,10 @@ use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::fmt::Write;
 
-use mbs_contact::{Contact, Shape};
+use mbs_contact::Shape;
 use mbs_core::{CoreError, Data, Transform, frame_pose, update_poses};
 
-use crate::action::{Action, PRESSER_PAD_RADIUS_MM, Presser};
+use crate::action::{Action, ContactElement, PRESSER_PAD_RADIUS_MM, Presser};
 use crate::error::Result;
 use crate::params::ActionParams;
 
@@ -1129,7 +1129,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
     for (&name, &e) in &action.contacts {
         let gap = action.gap(name, t, x)?;
         let ctx = system.element_context(&mut ws, t, x, e)?;
-        let contact = system.elements().nth(e).and_then(Contact::of);
+        let contact = system.elements().nth(e).and_then(ContactElement::of);
         let (shapes, point) = match contact {
             Some(c) => {
                 let shapes = c
@@ -1513,7 +1513,7 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
     let mut rest_data = Data::new(model);
     update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
     for (&name, &e) in &action.contacts {
-        let Some(c) = action.system.elements().nth(e).and_then(Contact::of) else {
+        let Some(c) = action.system.elements().nth(e).and_then(ContactElement::of) else {
             continue;
         };
         let mut sides = Vec::new();

@@ -38,8 +38,10 @@ pub mod toml_lines;
 pub mod touchweight;
 pub mod validate;
 
-pub use action::{Action, ModelKind, Presser};
+pub use action::{Action, ContactElement, ModelKind, Presser};
 pub use drawing::action_svg;
 pub use error::{InputError, InputKind, PianoError, Result};
 pub use params::ActionParams;
-pub use simulate::{Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate};
+pub use simulate::{
+    BLOW_PULSE_GAP_S, Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate,
+};

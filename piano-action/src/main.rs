@@ -233,10 +233,12 @@ fn simulate_scenario(
     write_run_dir(out, &scenario, params, &run).map_err(|e| e.to_string())?;
     for s in &run.strikes {
         println!(
-            "strike at {:.1} ms, hammer {:.2} m/s, contact {} ms",
+            "strike at {:.1} ms, hammer {:.2} m/s, contact {} ms, rebound {} m/s",
             s.time_s * 1e3,
             s.hammer_velocity_m_s,
-            ms(s.contact_duration_s)
+            ms(s.contact_duration_s),
+            s.rebound_velocity_m_s
+                .map_or("-".into(), |v| format!("{v:.2}"))
         );
     }
     println!("run directory: {}", out.display());

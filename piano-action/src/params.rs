@@ -243,13 +243,96 @@ pub struct ContactsParams {
     pub backcheck: ContactParams,
     /// Shank on the rest-rail cushion.
     pub rest_rail: ContactParams,
-    /// Hammer felt on the string.
-    pub hammer_string: ContactParams,
+    /// Hammer felt on the string (the string's motion, section `[string]`, gives the
+    /// losses and the rebound: no restitution here).
+    pub hammer_string: StringFeltParams,
+}
+
+/// The hammer felt against the string: C&A's power law `F = k δ^p`, undamped (the string
+/// takes the energy the hammer loses).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StringFeltParams {
+    /// Stiffness of the whole hammer's felt on the unison (N/m^p).
+    pub k: f64,
+    /// Exponent.
+    pub p: f64,
+    /// Friction coefficient along the string: must be 0 (not modelled).
+    pub mu: f64,
+    /// Restitution: no longer a parameter (read only to refuse it with a clear message;
+    /// files written before the string was modelled have it).
+    #[serde(default, skip_serializing)]
+    pub e: Option<f64>,
+}
+
+/// The string the hammer strikes: one note's unison, modal (`mbs_contact::TautString`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StringParams {
+    /// Speaking length, agraffe to bridge (m).
+    pub length_m: f64,
+    /// Fundamental of the ideal string (Hz).
+    pub fundamental_hz: f64,
+    /// Mass of one string's speaking length (g).
+    pub mass_per_string_g: f64,
+    /// Tension of one string (N); must agree with `4 L f1^2 Ms` within 1 %.
+    pub tension_per_string_n: f64,
+    /// Inharmonicity B.
+    pub inharmonicity: f64,
+    /// Striking ratio x0 / L.
+    pub striking_ratio: f64,
+    /// Strings in the unison.
+    pub strings: usize,
+    /// Frequency-independent loss b1 (1/s); sound only.
+    pub loss_b1_per_s: f64,
+    /// Frequency-dependent loss b3 (s); sound only.
+    pub loss_b3_s: f64,
+    /// Number of modes.
+    pub modes: usize,
+    /// Whether the cut modes' static compliance is kept as a spring in series with the
+    /// felt.
+    pub residual_compliance: bool,
+}
+
+impl StringParams {
+    /// The string's data in `mbs_contact` form.
+    pub fn spec(&self) -> mbs_contact::StringSpec {
+        mbs_contact::StringSpec {
+            length_m: self.length_m,
+            fundamental_hz: self.fundamental_hz,
+            mass_kg: Some(self.mass_per_string_g * 1e-3),
+            tension_n: Some(self.tension_per_string_n),
+            inharmonicity: self.inharmonicity,
+            striking_ratio: self.striking_ratio,
+            strings: self.strings,
+            loss_b1: self.loss_b1_per_s,
+            loss_b3: self.loss_b3_s,
+            modes: Some(self.modes),
+            residual_compliance: self.residual_compliance,
+        }
+    }
+
+    /// The string's modes; an error names the field (`string.tension_per_string_n`).
+    pub fn build(&self) -> Result<mbs_contact::TautString> {
+        mbs_contact::TautString::new(&self.spec()).map_err(|e| match e {
+            mbs_contact::ContactError::InvalidParameter { item, message } => {
+                let field = match item.trim_start_matches("string.") {
+                    "mass_kg" => "mass_per_string_g",
+                    "tension_n" => "tension_per_string_n",
+                    "loss_b1" => "loss_b1_per_s",
+                    "loss_b3" => "loss_b3_s",
+                    other => other,
+                };
+                PianoError::params(format!("string.{field}"), message)
+            }
+            other => PianoError::params("string", other.to_string()),
+        })
+    }
 }
 
 impl ContactsParams {
     /// The contacts by their field names.
-    pub fn named(&self) -> [(&'static str, &ContactParams); 10] {
+    pub fn named(&self) -> [(&'static str, &ContactParams); 9] {
         [
             ("front_rail", &self.front_rail),
             ("back_rail", &self.back_rail),
@@ -260,13 +343,43 @@ impl ContactsParams {
             ("drop_screw", &self.drop_screw),
             ("backcheck", &self.backcheck),
             ("rest_rail", &self.rest_rail),
-            ("hammer_string", &self.hammer_string),
         ]
     }
 
     /// Checks every contact law: stiffness positive, exponent 1 to 5, restitution in
-    /// (0, 1], friction 0 to 2, naming the contact and the field (`contacts.backcheck.e`).
+    /// (0, 1], friction 0 to 2, naming the contact and the field (`contacts.backcheck.e`);
+    /// the hammer–string felt has no restitution and no friction.
     pub fn check(&self) -> Result<()> {
+        let h = &self.hammer_string;
+        let field = |f: &str| format!("contacts.hammer_string.{f}");
+        if h.e.is_some() {
+            return Err(PianoError::params(
+                field("e"),
+                "the hammer-string contact has no restitution any more: the string's motion \
+                 gives the rebound (section [string]); remove this line",
+            ));
+        }
+        if !(h.k.is_finite() && h.k > 0.0) {
+            return Err(PianoError::params(
+                field("k"),
+                format!("the hammer felt's stiffness must be positive, got {}", h.k),
+            ));
+        }
+        if !(1.0..=5.0).contains(&h.p) {
+            return Err(PianoError::params(
+                field("p"),
+                format!("the hammer felt's exponent must be 1 to 5, got {}", h.p),
+            ));
+        }
+        if h.mu != 0.0 {
+            return Err(PianoError::params(
+                field("mu"),
+                format!(
+                    "friction along the string is not modelled: must be 0, got {}",
+                    h.mu
+                ),
+            ));
+        }
         for (name, c) in self.named() {
             let field = |f: &str| format!("contacts.{name}.{f}");
             if !(c.k.is_finite() && c.k > 0.0) {
@@ -351,6 +464,8 @@ pub struct ActionParams {
     pub regulation: RegulationParams,
     /// Contact laws.
     pub contacts: ContactsParams,
+    /// The string the hammer strikes.
+    pub string: StringParams,
     /// Numerical settings.
     pub numerics: NumericsParams,
 }
@@ -417,6 +532,7 @@ impl ActionParams {
             ),
         ];
         self.contacts.check()?;
+        self.string.build()?;
         // Beyond 10 % per step the integrator's error control means nothing [D].
         if self.numerics.relative_tolerance > 0.1 {
             return Err(PianoError::params(

@@ -96,7 +96,7 @@ pub(crate) fn slow_press(
     let mut toe = None;
     for i in 0..solution.len() {
         let (t, x) = (solution.t[i], solution.state(i));
-        gap_mm.push(a.gap("hammer_string", t, x)? * 1e3);
+        gap_mm.push(a.string_rest_gap(t, x)? * 1e3);
         if toe.is_none() && kind != ModelKind::Simplified && a.gap("let_off_button", t, x)? < 0.0 {
             toe = Some(i);
         }
@@ -149,7 +149,7 @@ fn at_rest(params: &ActionParams, kind: ModelKind) -> Result<(f64, f64, f64)> {
     let settled = run(&mut rest, vec![(0.0, 0.0)], 0.3, 2e-3)?;
     let (t, x) = (settled.t_final, &settled.y_final);
     Ok((
-        rest.gap("hammer_string", t, x)? * 1e3,
+        rest.string_rest_gap(t, x)? * 1e3,
         rest.gap("rest_rail", t, x)? * 1e3,
         x[key],
     ))
@@ -192,7 +192,7 @@ fn firm_press(
         && struck
         && firm.gap("backcheck", held.t_final, &held.y_final)? < 0.0
     {
-        Some(firm.gap("hammer_string", held.t_final, &held.y_final)? * 1e3)
+        Some(firm.string_rest_gap(held.t_final, &held.y_final)? * 1e3)
     } else {
         None
     };

@@ -48,11 +48,16 @@ fn r(v: f64, digits: i32) -> f64 {
 
 /// The rows of `trajectory.csv`: column names and values.
 fn read_trajectory(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
-    let text = read(dir, "trajectory.csv")?;
+    read_numeric_csv(dir, "trajectory.csv")
+}
+
+/// A CSV of finite numbers with a header line: header and rows.
+fn read_numeric_csv(dir: &Path, name: &str) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let text = read(dir, name)?;
     let mut lines = text.lines();
     let header: Vec<String> = lines
         .next()
-        .ok_or_else(|| bad(dir, "trajectory.csv is empty".into()))?
+        .ok_or_else(|| bad(dir, format!("{name} is empty")))?
         .split(',')
         .map(str::to_string)
         .collect();
@@ -62,12 +67,12 @@ fn read_trajectory(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
             continue;
         }
         let row: std::result::Result<Vec<f64>, _> = line.split(',').map(str::parse).collect();
-        let row = row.map_err(|e| bad(dir, format!("trajectory.csv line {}: {e}", i + 2)))?;
+        let row = row.map_err(|e| bad(dir, format!("{name} line {}: {e}", i + 2)))?;
         if row.len() != header.len() || row.iter().any(|v| !v.is_finite()) {
             return Err(bad(
                 dir,
                 format!(
-                    "trajectory.csv line {}: expected {} finite numbers",
+                    "{name} line {}: expected {} finite numbers",
                     i + 2,
                     header.len()
                 ),
@@ -76,7 +81,7 @@ fn read_trajectory(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
         rows.push(row);
     }
     if rows.is_empty() {
-        return Err(bad(dir, "trajectory.csv has no rows".into()));
+        return Err(bad(dir, format!("{name} has no rows")));
     }
     Ok((header, rows))
 }
@@ -212,6 +217,29 @@ pub fn run_data(dir: &Path) -> Result<Value> {
             ));
         }
     }
+    // The internal states (the string's modes), when the model has any: without them
+    // the string would be drawn at rest and its force recomputed as zero.
+    let internal = x0.len() - 2 * nv;
+    let internal_rows = if internal > 0 {
+        let (h, r) = read_numeric_csv(dir, crate::scenario::INTERNAL_STATES_CSV)?;
+        if h.len() != 1 + internal || r.len() != rows.len() {
+            return Err(bad(
+                dir,
+                format!(
+                    "{} has {} columns and {} rows; the {} model needs {} and trajectory.csv has {}",
+                    crate::scenario::INTERNAL_STATES_CSV,
+                    h.len(),
+                    r.len(),
+                    kind.name(),
+                    1 + internal,
+                    rows.len()
+                ),
+            ));
+        }
+        r
+    } else {
+        Vec::new()
+    };
     let drive_col = header.iter().position(|h| h == "key_drive_force_n");
     let key = model.coordinate_id("key")?;
     let hammer = model.coordinate_id("hammer")?;
@@ -260,9 +288,12 @@ pub fn run_data(dir: &Path) -> Result<Value> {
     let mut ws = action.system.workspace();
     let mut potential0 = None;
     let mut x = x0.clone();
-    for row in &rows {
+    for (i, row) in rows.iter().enumerate() {
         let time = row[0];
         x[..2 * nv].copy_from_slice(&row[1..1 + 2 * nv]);
+        if let Some(states) = internal_rows.get(i) {
+            x[2 * nv..].copy_from_slice(&states[1..]);
+        }
         t.push(r(time, 6));
         let c = crate::drawing::carry(&action, time, &x)?;
         for (slot, (_, m)) in carry.iter_mut().zip(&c) {

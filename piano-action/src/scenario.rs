@@ -555,6 +555,10 @@ fn write_json(dir: &Path, name: &str, value: &serde_json::Value) -> Result<()> {
     write_file(dir, name, &text)
 }
 
+/// The run-directory file with the force elements' internal states (time, then one column
+/// per state, `state_<index in the state vector>`), written when the model has any.
+pub const INTERNAL_STATES_CSV: &str = "internal_states.csv";
+
 /// Whether `name` is a file that `piano` writes into a run directory (by `simulate`,
 /// `report` or `plot`).
 pub fn is_run_output(name: &str) -> bool {
@@ -562,6 +566,7 @@ pub fn is_run_output(name: &str) -> bool {
         name,
         "run.json"
             | "trajectory.csv"
+            | INTERNAL_STATES_CSV
             | "contacts.csv"
             | "events.json"
             | "summary.json"
@@ -710,6 +715,24 @@ pub fn write_run_dir(
         csv.push('\n');
     }
     write_file(dir, "trajectory.csv", &csv)?;
+    // The force elements' internal states (the string's modal amplitudes) on the same
+    // grid, so that the report sees the string where the run left it.
+    let internal = prepared.action.system.state_len().saturating_sub(2 * nv);
+    if internal > 0 {
+        let mut csv = String::from("time_s");
+        for k in 0..internal {
+            let _ = write!(csv, ",state_{}", 2 * nv + k);
+        }
+        csv.push('\n');
+        for i in 0..sol.len() {
+            let _ = write!(csv, "{}", sol.t[i]);
+            for v in &sol.state(i)[2 * nv..] {
+                let _ = write!(csv, ",{v}");
+            }
+            csv.push('\n');
+        }
+        write_file(dir, INTERNAL_STATES_CSV, &csv)?;
+    }
     write_contacts_and_drawings(dir, &prepared, run)?;
 
     let events: Vec<serde_json::Value> = run
@@ -726,6 +749,8 @@ pub fn write_run_dir(
                 "time_s": s.time_s,
                 "hammer_velocity_m_s": s.hammer_velocity_m_s,
                 "contact_duration_s": num(s.contact_duration_s),
+                "rebound_velocity_m_s": num(s.rebound_velocity_m_s),
+                "pulses": s.pulses,
             })
         })
         .collect();

@@ -417,7 +417,21 @@ pub struct Strike {
     pub hammer_velocity_m_s: f64,
     /// How long the felt stays on the string (s); `None` if the run ends in contact.
     pub contact_duration_s: Option<f64>,
+    /// Speed of the strike point leaving the string (m/s, away from it); `None` if the run
+    /// ends in contact. Over the strike speed it is the restitution the string gives.
+    pub rebound_velocity_m_s: Option<f64>,
+    /// Contact pulses in the blow (1 for a clean blow): the pulse reflected from the agraffe
+    /// can lift a slow hammer off the string for a fraction of a millisecond, and the
+    /// contacts that follow within [`BLOW_PULSE_GAP_S`] belong to the same blow;
+    /// `contact_duration_s` runs from the first touch to the last release.
+    pub pulses: usize,
 }
+
+/// Contacts of the hammer on the string that start less than this after the last one ended
+/// are pulses of the same blow, not a second strike (s): 5 ms, more than a C4 string period
+/// (3.8 ms), so the string's reflections cannot split a blow, and far less than a hammer
+/// thrown back up by the action needs to return (a double strike takes 20 ms or more).
+pub const BLOW_PULSE_GAP_S: f64 = 5e-3;
 
 /// The result of a keystroke.
 #[derive(Clone, Debug)]
@@ -757,16 +771,29 @@ pub fn simulate_observed(
                     _ => {}
                 }
                 if contact == "hammer_string" {
+                    let same_blow = strikes.last_mut().filter(|s| {
+                        s.contact_duration_s
+                            .is_some_and(|d| ev.time - (s.time_s + d) < BLOW_PULSE_GAP_S)
+                    });
                     if onset {
-                        strikes.push(Strike {
-                            time_s: ev.time,
-                            hammer_velocity_m_s: ev.state[nv + hammer].abs() * strike_radius,
-                            contact_duration_s: None,
-                        });
+                        if let Some(s) = same_blow {
+                            s.pulses += 1;
+                            s.contact_duration_s = None;
+                        } else {
+                            strikes.push(Strike {
+                                time_s: ev.time,
+                                hammer_velocity_m_s: ev.state[nv + hammer].abs() * strike_radius,
+                                contact_duration_s: None,
+                                rebound_velocity_m_s: None,
+                                pulses: 1,
+                            });
+                        }
                     } else if let Some(s) = strikes.last_mut()
                         && s.contact_duration_s.is_none()
                     {
                         s.contact_duration_s = Some(ev.time - s.time_s);
+                        // The hammer turns away from the string: a negative rate.
+                        s.rebound_velocity_m_s = Some(-ev.state[nv + hammer] * strike_radius);
                     }
                 }
             }

@@ -154,7 +154,7 @@ pub fn sweep(
 /// The CSV columns of [`csv`].
 pub const CSV_HEADER: &str = "touch,value,unit,hammer_velocity_m_s,string_contact_s,\
 contact_duration_s,key_start_s,travel_time_s,let_off_s,key_bottom_s,\
-key_bottom_minus_string_contact_s,check_s,strikes,error";
+key_bottom_minus_string_contact_s,check_s,strikes,rebound_velocity_m_s,error";
 
 /// The rows as CSV (header [`CSV_HEADER`]): times in seconds, empty where a thing did not
 /// happen; `error` says why a run failed.
@@ -169,7 +169,7 @@ pub fn csv(kind: SweepKind, rows: &[SweepRow]) -> String {
                 let s = run.strikes.first();
                 let _ = writeln!(
                     out,
-                    "{},{},{},{},{},{},{},{},{},{},",
+                    "{},{},{},{},{},{},{},{},{},{},{},",
                     opt(s.map(|s| s.hammer_velocity_m_s)),
                     opt(s.map(|s| s.time_s)),
                     opt(s.and_then(|s| s.contact_duration_s)),
@@ -180,6 +180,7 @@ pub fn csv(kind: SweepKind, rows: &[SweepRow]) -> String {
                     opt(run.key_bottom_time_s.zip(s).map(|(k, s)| k - s.time_s)),
                     opt(run.check_time_s),
                     run.strikes.len(),
+                    opt(s.and_then(|s| s.rebound_velocity_m_s)),
                 );
             }
             Err(e) => {
@@ -187,7 +188,7 @@ pub fn csv(kind: SweepKind, rows: &[SweepRow]) -> String {
                     .chars()
                     .map(|c| if c == ',' || c == '\n' { ';' } else { c })
                     .collect();
-                let _ = writeln!(out, ",,,,,,,,,0,{clean}");
+                let _ = writeln!(out, ",,,,,,,,,0,,{clean}");
             }
         }
     }

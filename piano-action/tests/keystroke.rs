@@ -41,10 +41,11 @@ fn escapement_actions_let_off_strike_and_check() {
             "{kind:?}: let-off {let_off} before the strike {}",
             strikes[0]
         );
-        // The hammer felt stays on the string for 1–4 ms (literature.md §3).
+        // The hammer felt stays on the string for 1.5–3 ms: the modal string's C4 contact
+        // (string_reference.md §4.1: 1.95 ms at 4 m/s to 2.54 ms at 0.5 m/s).
         let contact = strikes[1] - strikes[0];
         assert!(
-            (0.5e-3..4e-3).contains(&contact),
+            (1.5e-3..3e-3).contains(&contact),
             "{kind:?}: string contact {contact} s"
         );
         // Afterwards the hammer is caught by the backcheck below the string and stays there.
@@ -79,8 +80,21 @@ fn the_simplified_action_holds_the_hammer_against_the_string() {
         "hammer at {} deg",
         end.to_degrees()
     );
-    let gap = action
-        .gap("hammer_string", sol.t_final, &sol.y_final)
-        .unwrap();
-    assert!(gap < 1e-4, "gap {gap}");
+    // The string it was driven into rings (lossless in the integrated states, about 1 mm
+    // at the strike point after this 20 N blow) and keeps kicking the felt: over the last
+    // 20 ms the hammer touches it again and again and never gets more than 4 mm away
+    // (an escaped hammer falls back by 7 mm or more).
+    let late: Vec<usize> = (0..sol.len()).filter(|&i| sol.t[i] > 0.08).collect();
+    let gaps: Vec<f64> = late
+        .iter()
+        .map(|&i| action.gap("hammer_string", sol.t[i], sol.state(i)).unwrap())
+        .collect();
+    let widest = gaps.iter().copied().fold(f64::MIN, f64::max);
+    assert!(widest < 4e-3, "the hammer left the string by {widest} m");
+    let touches = sol
+        .events
+        .iter()
+        .filter(|e| e.name == "contact 'hammer_string' #0" && e.time > 0.08)
+        .count();
+    assert!(touches >= 2, "{touches} string events in the last 20 ms");
 }

@@ -116,3 +116,65 @@ fn bad_parameter_files_name_the_field() {
         p
     );
 }
+
+#[test]
+fn the_string_section_is_checked_and_the_old_restitution_refused() {
+    let default = piano_action::params::DEFAULT_PARAMS_TOML;
+    let p = ActionParams::reference();
+    // The C4 unison of Chaigne & Askenfelt, three strings, 48 modes.
+    let string = p.string.build().unwrap();
+    assert_eq!((string.strings(), string.modes()), (3, 48));
+    assert!((string.unison_impedance() - 6.18).abs() < 0.01);
+    // A file written before the string was modelled gives the hammer-string contact a
+    // restitution: refused, named, on its line, saying why.
+    let old = default.replace(
+        "p = 2.5                               # [S] Chaigne & Askenfelt C4\n",
+        "p = 2.5\ne = 0.6\n",
+    );
+    assert_ne!(old, default);
+    let e = ActionParams::from_toml_str(&old).unwrap_err();
+    assert_eq!(e.field(), "contacts.hammer_string.e", "{e}");
+    let line = old.lines().position(|l| l == "e = 0.6").unwrap() + 1;
+    assert!(e.to_string().contains(&format!("line {line}")), "{e}");
+    assert!(e.to_string().contains("rebound"), "{e}");
+    // Friction along the string is not modelled.
+    let text = default.replace(
+        "mu = 0.0                              # friction along the string",
+        "mu = 0.2                              # friction along the string",
+    );
+    let e = ActionParams::from_toml_str(&text).unwrap_err();
+    assert_eq!(e.field(), "contacts.hammer_string.mu", "{e}");
+    // The string's own fields, named as in the file.
+    for (from, to, field) in [
+        (
+            "tension_per_string_n = 670.0",
+            "tension_per_string_n = 750.0",
+            "string.tension_per_string_n",
+        ),
+        (
+            "striking_ratio = 0.12",
+            "striking_ratio = 1.2",
+            "string.striking_ratio",
+        ),
+        ("modes = 48", "modes = 0", "string.modes"),
+        ("strings = 3", "strings = 0", "string.strings"),
+        (
+            "loss_b1_per_s = 0.5",
+            "loss_b1_per_s = -0.5",
+            "string.loss_b1_per_s",
+        ),
+        ("length_m = 0.62", "length_m = nan", "string.length_m"),
+    ] {
+        let text = default.replace(from, to);
+        assert_ne!(text, default, "{from}");
+        let e = ActionParams::from_toml_str(&text).unwrap_err();
+        assert_eq!(e.field(), field, "{e}");
+        assert!(e.to_string().contains("line"), "{e}");
+    }
+    let without: Vec<&str> = default
+        .lines()
+        .filter(|l| !l.starts_with("modes = "))
+        .collect();
+    let e = ActionParams::from_toml_str(&without.join("\n")).unwrap_err();
+    assert!(e.to_string().contains("modes"), "{e}");
+}

@@ -95,7 +95,12 @@ fn the_report_embeds_the_run_and_nothing_from_the_network() {
         .max_by(|&a, &b| f[a].as_f64().unwrap().total_cmp(&f[b].as_f64().unwrap()))
         .unwrap();
     assert!(f[peak].as_f64().unwrap() > 5.0, "string force {}", f[peak]);
-    assert!((f[peak].as_f64().unwrap() - crow[peak][col]).abs() < 1e-2);
+    assert!(
+        (f[peak].as_f64().unwrap() - crow[peak][col]).abs() < 1e-2,
+        "report {} vs csv {}",
+        f[peak],
+        crow[peak][col]
+    );
     assert_eq!(f[0].as_f64().unwrap(), 0.0);
     // The force acts on the hammer, pushing it down, at the string's height.
     let ny = run["contacts"]["hammer_string"]["ny"][peak]

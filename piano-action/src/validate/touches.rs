@@ -200,9 +200,15 @@ fn read_blow(params: &ActionParams, kind: ModelKind, out: &mut Blow) -> Result<(
         && run.check_time_s.is_some()
         && action.gap("backcheck", sol.t_final, &sol.y_final)? < 0.0
     {
-        out.check_mm = Some(action.gap("hammer_string", sol.t_final, &sol.y_final)? * 1e3);
+        out.check_mm = Some(crown_to_string_mm(&action, sol.t_final, &sol.y_final)?);
     }
     Ok(())
+}
+
+/// The crown's distance (mm) to the string line at rest, what a technician measures
+/// (the string may still ring after a blow).
+fn crown_to_string_mm(action: &Action, t: f64, x: &[f64]) -> Result<f64> {
+    Ok(action.string_rest_gap(t, x)? * 1e3)
 }
 
 /// e = −v_out / v_in of the first strike: the hammer's speed at the end of the contact
@@ -245,7 +251,7 @@ fn free_flight_mm(action: &Action, run: &Run) -> Result<Option<f64>> {
     {
         // The event state is just past the crossing: an open gap is a release.
         released = if action.gap("jack_knuckle", e.time, &e.state)? > 0.0 {
-            Some(action.gap("hammer_string", e.time, &e.state)? * 1e3)
+            Some(crown_to_string_mm(action, e.time, &e.state)?)
         } else {
             None
         };
