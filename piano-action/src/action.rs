@@ -700,6 +700,14 @@ impl Action {
         self.system.elements().nth(e).and_then(StringContact::of)
     }
 
+    /// Where the string's internal states lie in the state vector (its modal amplitudes
+    /// `[A_1..A_N, B_1..B_N]` first), if the action has a string.
+    pub fn string_state_range(&self) -> Option<std::ops::Range<usize>> {
+        self.string_contact()?;
+        let e = *self.contacts.get("hammer_string")?;
+        self.system.element_state_range(e)
+    }
+
     /// The distance (m) from the hammer crown to the string line at rest at time `t` and
     /// state `x`: what a technician measures (blow distance, check), free of the string's
     /// ringing; [`Action::gap`] gives the felt's own gap (negative in contact).

@@ -33,6 +33,7 @@ pub mod regulation;
 pub mod report;
 pub mod scenario;
 pub mod simulate;
+pub mod sound;
 pub mod sweep;
 pub mod toml_lines;
 pub mod touchweight;

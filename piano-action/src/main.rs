@@ -38,8 +38,13 @@ enum Command {
         /// Also write the interactive report, DIR/report.html.
         #[arg(long)]
         report: bool,
+        /// Also write the string's bridge force as sound: a 48 kHz 16-bit mono WAV, at
+        /// least 2 s long (the string rings on after the run; no damper is modelled), with
+        /// 100 N as full scale so soft and loud blows keep their levels.
+        #[arg(long, value_name = "FILE")]
+        wav: Option<std::path::PathBuf>,
         /// Replace an earlier run in DIR (only the files a run writes are removed; your
-        /// own files, such as measured.csv, stay).
+        /// own files, such as measured.csv, stay) and an existing --wav file.
         #[arg(long)]
         force: bool,
     },
@@ -144,7 +149,17 @@ fn plot(
 /// Checks a file a command is about to write: named `*.EXTENSION`, in a folder that exists,
 /// not a folder itself, and not replacing a file unless `force` is set.
 fn check_out_file(out: &std::path::Path, extension: &str, force: bool) -> Result<(), String> {
-    let flag_error = |why: String| format!("option --out: {}: {why}", out.display());
+    check_file_option("--out", out, extension, force)
+}
+
+/// [`check_out_file`] for the file of option `flag`.
+fn check_file_option(
+    flag: &str,
+    out: &std::path::Path,
+    extension: &str,
+    force: bool,
+) -> Result<(), String> {
+    let flag_error = |why: String| format!("option {flag}: {}: {why}", out.display());
     if out.extension().and_then(|e| e.to_str()) != Some(extension) {
         return Err(flag_error(format!(
             "this command writes {}, so the file must end in .{extension}",
@@ -165,7 +180,7 @@ fn check_out_file(out: &std::path::Path, extension: &str, force: bool) -> Result
     }
     if out.exists() && !force {
         return Err(format!(
-            "{}: exists; choose another --out, or pass --force to replace it",
+            "{}: exists; choose another {flag}, or pass --force to replace it",
             out.display()
         ));
     }
@@ -188,6 +203,7 @@ fn simulate_scenario(
     path: &std::path::Path,
     out: &std::path::Path,
     report: bool,
+    wav: Option<&std::path::Path>,
     force: bool,
 ) -> Result<(), String> {
     use piano_action::scenario::{
@@ -197,9 +213,15 @@ fn simulate_scenario(
     // Refuse an earlier run before spending time on this one; replace it (with --force)
     // only once the new run has succeeded.
     check_run_dir(out, force).map_err(|e| e.to_string())?;
+    if let Some(wav) = wav {
+        check_file_option("--wav", wav, "wav", force)?;
+    }
     if let InputSpec::Pendulum(piano_action::scenario::PendulumSpec { release_angle_deg }) =
         scenario.input
     {
+        if wav.is_some() {
+            return Err("option --wav: the swing test has no string to sound; drop --wav".into());
+        }
         let swing = piano_action::pendulum::swing_sampled(
             params,
             release_angle_deg,
@@ -242,9 +264,45 @@ fn simulate_scenario(
         );
     }
     println!("run directory: {}", out.display());
+    if let Some(wav) = wav {
+        write_sound(params, &scenario, &run, wav)?;
+    }
     if report {
         write_report(&[out.to_path_buf()], &out.join("report.html"), false)?;
     }
+    Ok(())
+}
+
+/// Writes the run's bridge force to `wav` and prints its levels.
+fn write_sound(
+    params: &ActionParams,
+    scenario: &piano_action::scenario::Scenario,
+    run: &piano_action::Run,
+    wav: &std::path::Path,
+) -> Result<(), String> {
+    use piano_action::sound;
+    let input = scenario.input.to_input().map_err(|e| e.to_string())?;
+    let kind = scenario.model_kind().map_err(|e| e.to_string())?;
+    let prepared =
+        piano_action::simulate::prepare(params, kind, &input).map_err(|e| e.to_string())?;
+    let force = sound::bridge_force(&prepared.action, run).map_err(|e| e.to_string())?;
+    let levels = sound::write_wav(wav, &force).map_err(|e| e.to_string())?;
+    println!(
+        "sound: {} ({:.1} s, bridge force peak {:.1} N, rms {:.1} N over the first 0.1 s{})",
+        wav.display(),
+        levels.seconds,
+        levels.peak_n,
+        levels.attack_rms_n,
+        if levels.clipped > 0 {
+            format!(
+                ", {} samples clipped at {} N",
+                levels.clipped,
+                sound::FULL_SCALE_N
+            )
+        } else {
+            String::new()
+        }
+    );
     Ok(())
 }
 
@@ -735,8 +793,9 @@ fn main() -> ExitCode {
                 scenario,
                 out,
                 report,
+                wav,
                 force,
-            } => simulate_scenario(&params, &scenario, &out, report, force),
+            } => simulate_scenario(&params, &scenario, &out, report, wav.as_deref(), force),
             Command::Plot {
                 run,
                 format,

@@ -477,3 +477,72 @@ fn the_demo_prints_its_table_and_writes_a_report() {
     assert!(html.contains(r#"id="report-data""#));
     assert!(html.contains("pressed touch 10 N") && html.contains("struck touch 0.8 m/s"));
 }
+
+#[test]
+fn simulate_wav_writes_the_blow_as_sound_and_keeps_existing_files() {
+    let dir = std::env::temp_dir().join(format!("piano-wav-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = dir.join("loud.toml");
+    std::fs::write(
+        &scenario,
+        "model = \"double\"\nduration_s = 0.06\n[input]\nkind = \"force\"\nforce_n = 20.0\n",
+    )
+    .unwrap();
+    let wav = dir.join("loud.wav");
+    let sim = |out: &str, wav: &std::path::Path, force: bool| {
+        let out = dir.join(out);
+        let mut args = vec![
+            "simulate",
+            scenario.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--wav",
+            wav.to_str().unwrap(),
+        ];
+        if force {
+            args.push("--force");
+        }
+        piano(&args)
+    };
+    let (ok, stdout, err) = sim("a", &wav, false);
+    assert!(ok, "{err}");
+    assert!(
+        stdout.contains("sound: ") && stdout.contains("bridge force peak"),
+        "{stdout}"
+    );
+    // Two seconds at 48 kHz, 16 bit: 44 header bytes and 192 000 of samples.
+    assert_eq!(std::fs::metadata(&wav).unwrap().len(), 44 + 192_000);
+    // An existing file is refused before the run (no run directory is written) ...
+    let (ok, _, err) = sim("b", &wav, false);
+    assert!(
+        !ok && err.contains("exists") && err.contains("--wav"),
+        "{err}"
+    );
+    assert!(!dir.join("b").exists());
+    // ... and replaced with --force.
+    let (ok, _, err) = sim("c", &wav, true);
+    assert!(ok, "{err}");
+    // Another extension, and the swing test (no string), are refused.
+    let (ok, _, err) = sim("d", &dir.join("loud.mp3"), false);
+    assert!(
+        !ok && err.contains("option --wav") && err.contains(".wav"),
+        "{err}"
+    );
+    let swing = dir.join("swing.toml");
+    std::fs::write(
+        &swing,
+        "model = \"double\"\nduration_s = 0.5\n[input]\nkind = \"pendulum\"\nrelease_angle_deg = 30.0\n",
+    )
+    .unwrap();
+    let out = dir.join("e");
+    let (ok, _, err) = piano(&[
+        "simulate",
+        swing.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--wav",
+        dir.join("swing.wav").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("no string"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
