@@ -226,24 +226,38 @@ fn speed_axis() -> Axis {
 
 /// The charts of the page.
 pub fn charts(v: &Validation) -> Vec<Chart> {
-    let law: Vec<(f64, f64)> = (0..=60)
-        .map(|i| 0.2 * 40f64.powf(i as f64 / 60.0))
-        .map(|x| (x, goebl_travel_time_s(x) * 1e3))
-        .collect();
-    let scaled = |k: f64| law.iter().map(|&(x, y)| (x, y * k)).collect::<Vec<_>>();
+    let law = |touch: Touch| -> Vec<(f64, f64)> {
+        (0..=60)
+            .map(|i| 0.2 * 40f64.powf(i as f64 / 60.0))
+            .map(|x| (x, goebl_travel_time_s(x, touch) * 1e3))
+            .filter(|p| p.1 > 0.0)
+            .collect()
+    };
+    let scaled = |touch: Touch, k: f64| {
+        law(touch)
+            .iter()
+            .map(|&(x, y)| (x, y * k))
+            .collect::<Vec<_>>()
+    };
     let mut travel = vec![
         Series {
-            label: "Goebl law +-25 % (1-5 m/s rows)".into(),
+            label: "Goebl struck: law - 20 ms +-25 % (row)".into(),
             color: LITERATURE,
-            points: scaled(0.75),
+            points: scaled(Touch::Struck, 0.75),
             mark: Mark::Band {
-                upper: scaled(1.25),
+                upper: scaled(Touch::Struck, 1.25),
             },
         },
         Series {
-            label: "Goebl: 89 ms v^-0.57 [M]".into(),
+            label: "Goebl struck: 89 ms v^-0.57 - 20 ms [M]/[S]".into(),
             color: LITERATURE,
-            points: law.clone(),
+            points: law(Touch::Struck),
+            mark: Mark::Line { dashed: false },
+        },
+        Series {
+            label: "Goebl pressed: 89 ms v^-0.57 [M]".into(),
+            color: LITERATURE,
+            points: law(Touch::Pressed),
             mark: Mark::Line { dashed: true },
         },
     ];
