@@ -141,7 +141,7 @@ fn regulation_rows(params: &ActionParams, kind: ModelKind) -> Vec<Row> {
         rows.push(
             Row::new(
                 "regulation.check",
-                "check (crown to string, 20 N held)",
+                "check (crown to string, struck f, key held)",
                 get(|r| r.check_mm),
                 Band::Range(12.0, 16.0),
                 "mm",
