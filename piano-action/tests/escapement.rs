@@ -170,3 +170,33 @@ fn a_let_off_regulated_too_close_to_the_string_strikes_twice() {
     let once = strikes(&ActionParams::reference(), constant_speed(0.1, 5e-3));
     assert_eq!(once.strikes.len(), 1);
 }
+
+#[test]
+fn the_key_bottoms_after_the_string_contact_at_piano_and_before_it_at_forte() {
+    // Askenfelt & Jansson, Goebl et al. (literature §3.1-3.2 [S]): the key reaches the
+    // key bed well after the hammer meets the string in soft playing and a few ms before
+    // it in loud playing. Struck touches of about 1 m/s (p) and 4 m/s (f) at the string.
+    let params = ActionParams::reference();
+    let mut lags = Vec::new();
+    for finger_speed_m_s in [0.215, 1.15] {
+        let input = Input::Touch {
+            style: TouchStyle::Struck { finger_speed_m_s },
+            finger: Finger::default(),
+        };
+        let run = simulate(&params, ModelKind::Double, &input, 0.3, 1e-3).expect("runs");
+        let strike = run.strikes[0];
+        let lag_ms = (run.key_bottom_time_s.expect("bottoms") - strike.time_s) * 1e3;
+        eprintln!(
+            "finger {finger_speed_m_s} m/s: hammer {:.2} m/s, key bottom - string contact {lag_ms:.1} ms",
+            strike.hammer_velocity_m_s
+        );
+        lags.push((strike.hammer_velocity_m_s, lag_ms));
+    }
+    let ((v_p, p), (v_f, f)) = (lags[0], lags[1]);
+    assert!(
+        (0.7..1.4).contains(&v_p) && (3.0..5.0).contains(&v_f),
+        "{v_p} {v_f}"
+    );
+    assert!(p > 1.0, "p: key bottom {p} ms after the string contact");
+    assert!(f < -0.5, "f: key bottom {f} ms after the string contact");
+}
