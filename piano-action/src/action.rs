@@ -712,20 +712,22 @@ impl Action {
     /// state `x`: what a technician measures (blow distance, check), free of the string's
     /// ringing; [`Action::gap`] gives the felt's own gap (negative in contact).
     pub fn string_rest_gap(&self, t: f64, x: &[f64]) -> Result<f64> {
-        let unknown = || mbs_core::CoreError::UnknownName {
-            what: "contact",
-            name: "hammer_string".to_string(),
-        };
-        let e = *self.contacts.get("hammer_string").ok_or_else(unknown)?;
-        let string = self.string_contact().ok_or_else(unknown)?;
-        let mut ws = self.system.workspace();
-        let ctx = self.system.element_context(&mut ws, t, x, e)?;
-        Ok(string.rest_gap(&ctx))
+        self.with_string(t, x, |string, ctx| string.rest_gap(ctx))
     }
 
     /// The string at time `t` and state `x`: displacement and velocity at the strike
     /// point, bridge force, energy.
     pub fn string_output(&self, t: f64, x: &[f64]) -> Result<mbs_contact::StringOutput> {
+        self.with_string(t, x, |string, ctx| string.string_output(ctx))
+    }
+
+    /// `read` applied to the string element and its context at time `t`, state `x`.
+    fn with_string<T>(
+        &self,
+        t: f64,
+        x: &[f64],
+        read: impl FnOnce(&StringContact, &mbs_core::ForceContext<'_>) -> T,
+    ) -> Result<T> {
         let unknown = || mbs_core::CoreError::UnknownName {
             what: "contact",
             name: "hammer_string".to_string(),
@@ -734,7 +736,7 @@ impl Action {
         let string = self.string_contact().ok_or_else(unknown)?;
         let mut ws = self.system.workspace();
         let ctx = self.system.element_context(&mut ws, t, x, e)?;
-        Ok(string.string_output(&ctx))
+        Ok(read(string, &ctx))
     }
 
     /// The gap (m) of the named contact at time `t` and state `x` (the time matters when a
