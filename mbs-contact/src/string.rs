@@ -427,6 +427,26 @@ impl TautString {
         })
     }
 
+    /// `(sin ω_k t, cos ω_k t)` for every mode, into `out` (length [`TautString::modes`]).
+    fn trig_at(&self, t: f64, out: &mut [(f64, f64)]) {
+        for (o, w) in out.iter_mut().zip(&self.omega) {
+            *o = (w * t).sin_cos();
+        }
+    }
+
+    /// [`TautString::strike_point_motion`] with the trigonometry of its time given.
+    fn strike_point_motion_from(&self, trig: &[(f64, f64)], states: &[f64]) -> (f64, f64) {
+        let n = self.omega.len();
+        let (mut u, mut v) = (0.0, 0.0);
+        for k in 0..n {
+            let (a, b) = (states[k], states[n + k]);
+            let ((s, c), w, p) = (trig[k], self.omega[k], self.phi[k]);
+            u += p * (a * c + b * s);
+            v += p * (w * (b * c - a * s));
+        }
+        (u, v)
+    }
+
     /// Displacement (m, positive away from the striker) and velocity of the string at the
     /// strike point from the modes alone (the residual spring is the contact's business).
     pub fn strike_point_motion(&self, t: f64, states: &[f64]) -> (f64, f64) {
@@ -508,6 +528,9 @@ pub struct StringOutput {
 pub struct StringContact {
     name: String,
     string: Arc<TautString>,
+    /// The modes' trigonometry at the last time asked: the evaluations of one stage (Newton
+    /// iterations, Jacobian columns) share their time.
+    trig: TrigCache,
     /// The string at rest (a segment or a line, on the ground, world coordinates), facing
     /// the striker.
     at_rest: Shape,
@@ -522,6 +545,37 @@ impl std::fmt::Debug for StringContact {
             .field("modes", &self.string.modes())
             .field("felt", &self.felt)
             .finish_non_exhaustive()
+    }
+}
+
+/// `(t, [(sin ω_k t, cos ω_k t)])` of the last time asked, behind a lock so that the
+/// element stays `Sync`; a clone starts empty.
+struct TrigCache(std::sync::Mutex<(f64, Vec<(f64, f64)>)>);
+
+impl TrigCache {
+    fn new(modes: usize) -> Self {
+        TrigCache(std::sync::Mutex::new((f64::NAN, vec![(0.0, 0.0); modes])))
+    }
+
+    /// `read` applied to the trigonometry of `string` at `t` (computed if not cached).
+    fn with<T>(&self, string: &TautString, t: f64, read: impl FnOnce(&[(f64, f64)]) -> T) -> T {
+        let mut guard = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let (time, trig) = &mut *guard;
+        if time.to_bits() != t.to_bits() {
+            string.trig_at(t, trig);
+            *time = t;
+        }
+        read(trig)
+    }
+}
+
+impl Clone for TrigCache {
+    fn clone(&self) -> Self {
+        let modes = self
+            .0
+            .lock()
+            .map_or_else(|e| e.into_inner().1.len(), |g| g.1.len());
+        TrigCache::new(modes)
     }
 }
 
@@ -560,6 +614,7 @@ impl StringContact {
         }
         Ok(Self {
             name: format!("contact '{name}'"),
+            trig: TrigCache::new(string.modes()),
             string: Arc::new(string),
             at_rest,
             striker,
@@ -699,7 +754,9 @@ impl StringContact {
     ) -> (f64, f64, f64, Interaction) {
         let ns = self.string.state_count();
         let (modal, law_states) = ctx.states.split_at(ns);
-        let (u, u_rate) = self.string.strike_point_motion(ctx.t, modal);
+        let (u, u_rate) = self.trig.with(&self.string, ctx.t, |trig| {
+            self.string.strike_point_motion_from(trig, modal)
+        });
         let point = [
             0.5 * (p.point_a[0] + p.point_b[0]),
             0.5 * (p.point_a[1] + p.point_b[1]),
@@ -868,12 +925,14 @@ impl ForceElement for StringContact {
         let s = &self.string;
         let n = s.modes();
         let (da, db) = modal_rates.split_at_mut(n);
-        for k in 0..n {
-            let (sin, cos) = (s.omega[k] * ctx.t).sin_cos();
-            let g = s.gain[k] * f;
-            da[k] = -g * sin;
-            db[k] = g * cos;
-        }
+        self.trig.with(s, ctx.t, |trig| {
+            for k in 0..n {
+                let (sin, cos) = trig[k];
+                let g = s.gain[k] * f;
+                da[k] = -g * sin;
+                db[k] = g * cos;
+            }
+        });
     }
 
     fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
@@ -906,7 +965,13 @@ impl ForceElement for StringContact {
         out[0] = if lower > 0.0 {
             lower
         } else {
-            p.gap + self.string.strike_point_motion(ctx.t, modal).0
+            p.gap
+                + self
+                    .trig
+                    .with(&self.string, ctx.t, |trig| {
+                        self.string.strike_point_motion_from(trig, modal)
+                    })
+                    .0
         };
     }
 

@@ -62,6 +62,8 @@ pub(crate) struct TrBdf2 {
     est: Vec<f64>,
     jac: nalgebra::DMatrix<f64>,
     jac_tmp: Vec<f64>,
+    /// Columns of `jac` known to hold zeros (left out of the last Jacobians).
+    zero_columns: Vec<bool>,
     jac_valid: bool,
     /// Whether `jac` was evaluated at the start of the current step.
     jac_fresh: bool,
@@ -102,6 +104,7 @@ impl TrBdf2 {
             est: v(),
             jac: nalgebra::DMatrix::zeros(n, n),
             jac_tmp: v(),
+            zero_columns: vec![false; n],
             jac_valid: false,
             jac_fresh: false,
             lu: IterationMatrix::new(n),
@@ -131,25 +134,30 @@ impl TrBdf2 {
         if sys.has_jacobian() {
             sys.jacobian(t, y, &mut self.jac)
                 .map_err(|source| IntegratorError::System { t, source })?;
+            self.zero_columns.fill(false);
+            if self.jac.as_slice().iter().any(|v| !v.is_finite()) {
+                return Err(IntegratorError::System {
+                    t,
+                    source: crate::SystemError::new("the Jacobian has non-finite entries"),
+                });
+            }
         } else {
+            let n = self.n;
             let mut yp = y.to_vec();
             // States the system marks as outside the Jacobian keep zero columns and cost
             // no evaluation (a string's modal amplitudes, see
             // `OdeSystem::states_outside_jacobian`).
-            let mut needed = vec![true; self.n];
+            let mut needed = vec![true; n];
             for r in sys.states_outside_jacobian() {
-                for j in r.start.min(self.n)..r.end.min(self.n) {
+                for j in r.start.min(n)..r.end.min(n) {
                     needed[j] = false;
-                    self.jac.column_mut(j).fill(0.0);
                 }
             }
             // The other internal states beyond a mechanical [q, v] (force elements'
             // memories) are probed together first: when moving them all at once changes no
             // derivative at all, their columns are zero and their evaluations are saved.
-            let grouped = sys
-                .second_order_split()
-                .map_or(self.n, |nv| (2 * nv).min(self.n));
-            let internal: Vec<usize> = (grouped..self.n).filter(|&j| needed[j]).collect();
+            let grouped = sys.second_order_split().map_or(n, |nv| (2 * nv).min(n));
+            let internal: Vec<usize> = (grouped..n).filter(|&j| needed[j]).collect();
             if internal.len() > 1 {
                 for &j in &internal {
                     yp[j] = y[j] + f64::EPSILON.sqrt() * y[j].abs().max(1e-5);
@@ -161,15 +169,23 @@ impl TrBdf2 {
                 if self.jac_tmp == f {
                     for &j in &internal {
                         needed[j] = false;
-                        self.jac.column_mut(j).fill(0.0);
                     }
                 }
             }
-            for j in (0..self.n).filter(|&j| needed[j]) {
+            for j in 0..n {
+                if !needed[j] {
+                    // Zeroed once, kept zero while the column stays out.
+                    if !self.zero_columns[j] {
+                        self.jac.column_mut(j).fill(0.0);
+                        self.zero_columns[j] = true;
+                    }
+                    continue;
+                }
                 let yj = y[j];
                 let dj = f64::EPSILON.sqrt() * yj.abs().max(1e-5);
                 yp[j] = yj + dj;
                 let dj = yp[j] - yj;
+                // `eval` refuses non-finite rates, so every column is finite.
                 if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
                     return Err(non_finite(t, &self.jac_tmp));
                 }
@@ -177,14 +193,9 @@ impl TrBdf2 {
                 for ((out, a), b) in column.into_iter().zip(&self.jac_tmp).zip(f) {
                     *out = (a - b) / dj;
                 }
+                self.zero_columns[j] = false;
                 yp[j] = yj;
             }
-        }
-        if self.jac.as_slice().iter().any(|v| !v.is_finite()) {
-            return Err(IntegratorError::System {
-                t,
-                source: crate::SystemError::new("the Jacobian has non-finite entries"),
-            });
         }
         self.jac_valid = true;
         self.jac_fresh = true;
