@@ -26,8 +26,10 @@ pub trait NormalLaw: Send + Sync + std::fmt::Debug {
         None
     }
 
-    /// Whether the force ignores `delta_dot` (a purely elastic law such as [`Hertz`]).
-    /// `false` by default: the law may depend on the rate.
+    /// Whether the law ignores `delta_dot` altogether: neither the force nor the rates of
+    /// its internal states depend on it (a purely elastic law such as [`Hertz`]). `false`
+    /// by default: the law may depend on the rate. [`crate::StringContact`] relies on it to
+    /// leave the string's modes out of an implicit integrator's Jacobian.
     fn rate_independent(&self) -> bool {
         false
     }

@@ -79,6 +79,14 @@ impl NormalLaw for MaterialLaw {
     fn force(&self, delta: f64, delta_dot: f64, states: &[f64], rates: &mut [f64]) -> f64 {
         self.as_dyn().force(delta, delta_dot, states, rates)
     }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        self.as_dyn().tangent_stiffness(delta, delta_dot, states)
+    }
+
+    fn rate_independent(&self) -> bool {
+        self.as_dyn().rate_independent()
+    }
 }
 
 macro_rules! material_law_from {

@@ -42,8 +42,9 @@ use crate::error::{ContactError, Result};
 use crate::geometry::{Proximity, Shape, proximity};
 use crate::laws::NormalLaw;
 
-/// Highest mode frequency kept by default (Hz): `N = ceil(f_max / f₁)` (12 kHz is enough
-/// for p to mf at C4, `string_reference.md` §5.2).
+/// Highest mode frequency of the *flexible* string kept by default (Hz): `N = ceil(f_max /
+/// f₁)` (12 kHz is enough for p to mf at C4, `string_reference.md` §5.2). Inharmonicity
+/// raises the actual top mode: C4's 46th is at about 16 kHz.
 pub const DEFAULT_MAX_FREQUENCY_HZ: f64 = 12_000.0;
 
 /// The most modes a string may have (a C1 string to 20 kHz needs about 600).
@@ -550,20 +551,25 @@ impl std::fmt::Debug for StringContact {
 
 /// `(t, [(sin ω_k t, cos ω_k t)])` of the last time asked, behind a lock so that the
 /// element stays `Sync`; a clone starts empty.
-struct TrigCache(std::sync::Mutex<(f64, Vec<(f64, f64)>)>);
+struct TrigCache(std::sync::Mutex<TrigEntry>);
+
+/// The bits of the time, when set, and `(sin ω_k t, cos ω_k t)` per mode.
+type TrigEntry = (Option<u64>, Vec<(f64, f64)>);
 
 impl TrigCache {
     fn new(modes: usize) -> Self {
-        TrigCache(std::sync::Mutex::new((f64::NAN, vec![(0.0, 0.0); modes])))
+        TrigCache(std::sync::Mutex::new((None, vec![(0.0, 0.0); modes])))
     }
 
     /// `read` applied to the trigonometry of `string` at `t` (computed if not cached).
     fn with<T>(&self, string: &TautString, t: f64, read: impl FnOnce(&[(f64, f64)]) -> T) -> T {
         let mut guard = self.0.lock().unwrap_or_else(|e| e.into_inner());
         let (time, trig) = &mut *guard;
-        if time.to_bits() != t.to_bits() {
+        if *time != Some(t.to_bits()) {
+            // Unkeyed while it is rewritten, so that an interrupted update is never read.
+            *time = None;
             string.trig_at(t, trig);
-            *time = t;
+            *time = Some(t.to_bits());
         }
         read(trig)
     }

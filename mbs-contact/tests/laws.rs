@@ -897,3 +897,25 @@ fn force_methods_do_not_allocate() {
     assert!(sum.is_finite());
     assert_eq!(after - before, 0, "force methods allocated");
 }
+
+#[test]
+fn only_a_purely_elastic_law_says_it_ignores_the_rate_also_through_a_material() {
+    // StringContact leaves its modes out of the Jacobian on this answer: it must be true
+    // only where neither force nor state rates see the penetration rate.
+    let hertz = Hertz::new(4.5e9, 2.5).unwrap();
+    assert!(hertz.rate_independent());
+    let (d, v) = (2e-4, 0.7);
+    let mut none: [f64; 0] = [];
+    assert_eq!(
+        hertz.force(d, v, &[], &mut none),
+        hertz.force(d, -v, &[], &mut none)
+    );
+    assert!(MaterialLaw::from(hertz).rate_independent(), "forwarded");
+    let felt = HystereticFelt::from_restitution(1e9, 2.5, 0.4, 1e-3).unwrap();
+    assert!(!felt.rate_independent());
+    assert!(!MaterialLaw::from(felt).rate_independent());
+    let k = MaterialLaw::from(hertz)
+        .tangent_stiffness(d, 0.0, &[])
+        .unwrap();
+    assert!((k - 2.5 * hertz.force(d, 0.0, &[], &mut none) / d).abs() < 1e-6 * k);
+}

@@ -187,8 +187,9 @@ pub trait ForceElement: Send + Sync {
     /// Which of this element's internal states (local indices) an implicit integrator may
     /// leave out of its Jacobian, their columns taken as zero. That holds for states whose
     /// rates move them only along directions that, at a fixed time, change neither the
-    /// loads nor any rate: the part of the iteration matrix left out is then nilpotent and
-    /// the modified Newton iteration converges as with the full matrix. Example: modal
+    /// loads nor any rate: the part of the iteration matrix left out is then nilpotent at the
+    /// Jacobian's time and the modified Newton iteration converges as with the full matrix
+    /// there (away from it, as with any Jacobian kept across stages). Example: modal
     /// amplitudes in variation-of-constants form driven by a force that depends on the
     /// modal displacement only (`mbs_contact::StringContact` with a rate-independent
     /// felt). None (`0..0`) by default.

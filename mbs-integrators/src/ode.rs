@@ -63,7 +63,8 @@ pub trait OdeSystem {
 
     /// Ranges of states whose Jacobian columns the implicit method may take as zero without
     /// evaluating them: states whose rates move them only along directions that change no
-    /// rate at a fixed time, so the part of the iteration matrix left out is nilpotent
+    /// rate at a fixed time, so the part of the iteration matrix left out is nilpotent (at
+    /// the Jacobian's time)
     /// (modal amplitudes in variation-of-constants form). None by default.
     fn states_outside_jacobian(&self) -> Vec<std::ops::Range<usize>> {
         Vec::new()

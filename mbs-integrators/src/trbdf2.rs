@@ -185,7 +185,8 @@ impl TrBdf2 {
                 let dj = f64::EPSILON.sqrt() * yj.abs().max(1e-5);
                 yp[j] = yj + dj;
                 let dj = yp[j] - yj;
-                // `eval` refuses non-finite rates, so every column is finite.
+                // `eval` refuses non-finite rates, so every column is finite (barring an
+                // overflow of the quotient).
                 if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
                     return Err(non_finite(t, &self.jac_tmp));
                 }

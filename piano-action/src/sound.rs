@@ -93,10 +93,17 @@ pub struct SoundLevels {
 }
 
 /// Writes `force` (N, sampled at [`SAMPLE_RATE_HZ`]) to `path` as a 16-bit mono PCM WAV
-/// with [`FULL_SCALE_N`] as full scale, fading out over the last 50 ms.
+/// with [`FULL_SCALE_N`] as full scale, fading out over the last 50 ms. Refuses a
+/// non-finite sample (nothing is written then).
 pub fn write_wav(path: &Path, force: &[f64]) -> Result<SoundLevels> {
     let fs = f64::from(SAMPLE_RATE_HZ);
     let fade = ((FADE_S * fs) as usize).min(force.len());
+    if let Some(i) = force.iter().position(|f| !f.is_finite()) {
+        return Err(PianoError::Simulation(format!(
+            "the bridge force is not finite at sample {i} ({} s)",
+            i as f64 / fs
+        )));
+    }
     let mut clipped = 0;
     let mut data = Vec::with_capacity(2 * force.len());
     for (i, f) in force.iter().enumerate() {
@@ -114,10 +121,11 @@ pub fn write_wav(path: &Path, force: &[f64]) -> Result<SoundLevels> {
         data.extend_from_slice(&sample.to_le_bytes());
     }
     let mut bytes = Vec::with_capacity(44 + data.len());
-    let data_len = u32::try_from(data.len())
-        .map_err(|_| PianoError::file(path, "the sound is too long for a WAV file"))?;
+    let too_long = || PianoError::file(path, "the sound is too long for a WAV file");
+    let data_len = u32::try_from(data.len()).map_err(|_| too_long())?;
+    let riff_len = data_len.checked_add(36).ok_or_else(too_long)?;
     bytes.extend_from_slice(b"RIFF");
-    bytes.extend_from_slice(&(36 + data_len).to_le_bytes());
+    bytes.extend_from_slice(&riff_len.to_le_bytes());
     bytes.extend_from_slice(b"WAVE");
     bytes.extend_from_slice(b"fmt ");
     bytes.extend_from_slice(&16u32.to_le_bytes()); // size of the fmt chunk

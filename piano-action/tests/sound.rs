@@ -170,3 +170,12 @@ fn the_wav_file_is_48_khz_16_bit_mono_at_a_fixed_full_scale() {
     assert_eq!(*bytes.last().unwrap(), 0, "faded out");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_non_finite_bridge_force_is_refused_and_nothing_is_written() {
+    let path = std::env::temp_dir().join(format!("piano-nan-{}.wav", std::process::id()));
+    let force = [0.0, 1.0, f64::NAN, 2.0];
+    let e = sound::write_wav(&path, &force).unwrap_err().to_string();
+    assert!(e.contains("not finite") && e.contains("sample 2"), "{e}");
+    assert!(!path.exists());
+}
