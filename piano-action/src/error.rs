@@ -108,6 +108,17 @@ pub enum PianoError {
     /// A contact could not be built.
     #[error(transparent)]
     Contact(#[from] mbs_contact::ContactError),
+    /// No parameter has this path (`piano params --list` prints them all).
+    #[error(
+        "no parameter '{path}'{}; `piano params --list` prints every path",
+        suggestion.as_ref().map_or(String::new(), |s| format!(" (did you mean '{s}'?)"))
+    )]
+    UnknownParameter {
+        /// The path asked for.
+        path: String,
+        /// The closest known path, if one is close.
+        suggestion: Option<String>,
+    },
 }
 
 impl PianoError {

@@ -26,6 +26,7 @@ mod error;
 pub mod fuzzing;
 pub mod geometry_check;
 pub mod measured;
+pub mod param_paths;
 pub mod params;
 pub mod pendulum;
 pub mod plot;

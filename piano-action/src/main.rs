@@ -81,8 +81,17 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
-    /// Write the default parameter file (with its comments and sources) to standard output.
-    Params,
+    /// Write the default parameter file (with its comments and sources) to standard output;
+    /// with --list, every numeric parameter instead: path, value, unit and source tag.
+    Params {
+        /// List every parameter by path (of --params FILE, or the defaults) with its value,
+        /// unit and source tag.
+        #[arg(long)]
+        list: bool,
+        /// With --list: print JSON, `[{"path", "value", "unit", "tags"}]`.
+        #[arg(long, requires = "list")]
+        json: bool,
+    },
     /// Regulate the action like a technician (front-rail punching, capstan, let-off button,
     /// drop screw, backcheck, rest rail) to the middle of the literature bands and print
     /// what it achieves: key dip, blow distance, let-off, drop, check, aftertouch (mm).
@@ -642,6 +651,52 @@ fn regulate(
     Ok(())
 }
 
+/// `piano params --list`: every numeric parameter with its value, unit and source tag (the
+/// tags read from `file`, or from the embedded defaults).
+fn list_parameters(
+    params: &ActionParams,
+    file: Option<&std::path::Path>,
+    json: bool,
+) -> Result<(), String> {
+    use std::fmt::Write as _;
+    use std::io::Write as _;
+    let source = match file {
+        Some(p) => std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?,
+        None => piano_action::params::DEFAULT_PARAMS_TOML.to_string(),
+    };
+    let list = params.parameter_list(&source).map_err(|e| e.to_string())?;
+    if json {
+        let rows: Vec<serde_json::Value> = list
+            .iter()
+            .map(|p| {
+                serde_json::json!({"path": p.path, "value": p.value, "unit": p.unit, "tags": p.tags})
+            })
+            .collect();
+        let text = serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?;
+        // A closed pipe (`| head`) ends the listing quietly.
+        let _ = writeln!(std::io::stdout().lock(), "{text}");
+        return Ok(());
+    }
+    let width = list.iter().map(|p| p.path.len()).max().unwrap_or(4);
+    let mut text = format!(
+        "{:width$}  {:>14}  {:10}  source\n",
+        "path", "value", "unit"
+    );
+    for p in &list {
+        let _ = writeln!(
+            text,
+            "{:width$}  {:>14}  {:10}  {}",
+            p.path,
+            format!("{}", p.value),
+            p.unit,
+            p.tags
+        );
+    }
+    let _ = writeln!(text, "{} parameters", list.len());
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    Ok(())
+}
+
 fn load(path: Option<&std::path::Path>) -> Result<ActionParams, String> {
     match path {
         None => Ok(ActionParams::reference()),
@@ -770,7 +825,7 @@ fn main() -> ExitCode {
     let unused = match &command {
         Command::Plot { .. } => Some("plot (the run directory holds its parameters)"),
         Command::Report { .. } => Some("report (the run directories hold their parameters)"),
-        Command::Params => Some("params (it writes the default file)"),
+        Command::Params { list: false, .. } => Some("params (it writes the default file)"),
         _ => None,
     };
     let result = match (unused, cli.params.as_deref()) {
@@ -808,11 +863,14 @@ fn main() -> ExitCode {
                 write_report(&runs, &out, force)
             }
             Command::Sweep(args) => sweep(&params, args),
-            Command::Params => {
+            Command::Params { list: false, .. } => {
                 use std::io::Write;
                 let _ = std::io::stdout()
                     .write_all(piano_action::params::DEFAULT_PARAMS_TOML.as_bytes());
                 Ok(())
+            }
+            Command::Params { list: true, json } => {
+                list_parameters(&params, cli.params.as_deref(), json)
             }
         }),
     };

@@ -139,9 +139,10 @@ fn the_string_section_is_checked_and_the_old_restitution_refused() {
     assert!(e.to_string().contains("rebound"), "{e}");
     // Friction along the string is not modelled.
     let text = default.replace(
-        "mu = 0.0                              # friction along the string",
-        "mu = 0.2                              # friction along the string",
+        "mu = 0.0                              # [M] friction along the string",
+        "mu = 0.2                              # [M] friction along the string",
     );
+    assert_ne!(text, default);
     let e = ActionParams::from_toml_str(&text).unwrap_err();
     assert_eq!(e.field(), "contacts.hammer_string.mu", "{e}");
     // The string's own fields, named as in the file.
