@@ -6,7 +6,11 @@
 //! a directory with `dataset.json` (the camera, the tracked markers and the runs) and one
 //! CSV of marker positions per run ([`Dataset::load`], [`Dataset::read_run`]). Every error
 //! names the file, the line and the field ([`DatasetError`]); nothing panics on a bad file.
+//! And the **camera**'s measurement model: a frame averages the motion over its exposure,
+//! shifted by the camera's unknown clock offset ([`Camera`]).
 
+mod camera;
 mod dataset;
 
+pub use camera::Camera;
 pub use dataset::{Dataset, DatasetError, MarkerSpec, Role, RunData, RunSpec, SCHEMA_VERSION};
