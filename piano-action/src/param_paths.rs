@@ -214,16 +214,13 @@ impl ActionParams {
 
 /// `a.b[2]` as the JSON pointer `/a/b/2`.
 fn pointer(path: &str) -> Option<String> {
+    use crate::toml_lines::Step;
     let mut out = String::new();
-    for part in path.split('.') {
-        let (key, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
+    for step in crate::toml_lines::steps(path)? {
         out.push('/');
-        out.push_str(key);
-        while let Some(stripped) = rest.strip_prefix('[') {
-            let close = stripped.find(']')?;
-            out.push('/');
-            out.push_str(&stripped[..close]);
-            rest = &stripped[close + 1..];
+        match step {
+            Step::Key(k) => out.push_str(k),
+            Step::Index(i) => out.push_str(&i.to_string()),
         }
     }
     Some(out)

@@ -21,13 +21,13 @@ pub fn line_at(text: &str, offset: usize) -> usize {
 }
 
 /// One step of a field path: a table key or an array index.
-enum Step<'a> {
+pub(crate) enum Step<'a> {
     Key(&'a str),
     Index(usize),
 }
 
 /// Splits `input.points[2][1]` into keys and indices; `None` for a path it cannot read.
-fn steps(path: &str) -> Option<Vec<Step<'_>>> {
+pub(crate) fn steps(path: &str) -> Option<Vec<Step<'_>>> {
     let mut out = Vec::new();
     for part in path.split('.') {
         let (key, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
