@@ -83,6 +83,22 @@ struct MotionOutcome {
 }
 
 impl MotionOutcome {
+    /// The blows of `run`; the first one's speed kept when `with_speed`.
+    fn of(run: &crate::simulate::Run, with_speed: bool) -> Self {
+        MotionOutcome {
+            strikes: run.strikes.len(),
+            blocked: run
+                .strikes
+                .last()
+                .is_some_and(|s| s.contact_duration_s.is_none()),
+            first_speed_m_s: run
+                .strikes
+                .first()
+                .filter(|_| with_speed)
+                .map(|s| s.hammer_velocity_m_s),
+        }
+    }
+
     /// Exactly one blow that left the string.
     fn single(&self) -> bool {
         self.strikes == 1 && !self.blocked
@@ -107,14 +123,7 @@ fn motion_strikes(
 ) -> Result<MotionOutcome> {
     let (points, t_dip) = profile.points(speed);
     let run = simulate(params, kind, &Input::Motion { points }, t_dip + 0.15, 1e-3)?;
-    Ok(MotionOutcome {
-        strikes: run.strikes.len(),
-        blocked: run
-            .strikes
-            .last()
-            .is_some_and(|s| s.contact_duration_s.is_none()),
-        first_speed_m_s: run.strikes.first().map(|s| s.hammer_velocity_m_s),
-    })
+    Ok(MotionOutcome::of(&run, true))
 }
 
 /// The motion families: (id, description, profile and speed of each run).
@@ -308,14 +317,7 @@ pub(super) fn control_rows(params: &ActionParams, kind: ModelKind) -> Vec<Row> {
                 2e-3,
             )?,
         };
-        Ok(MotionOutcome {
-            strikes: run.strikes.len(),
-            blocked: run
-                .strikes
-                .last()
-                .is_some_and(|s| s.contact_duration_s.is_none()),
-            first_speed_m_s: None,
-        })
+        Ok(MotionOutcome::of(&run, false))
     };
     let (close, outcomes) = rayon::join(
         || close_let_off(params, kind),

@@ -116,11 +116,7 @@ pub fn markdown(v: &Validation) -> String {
             }
         );
     }
-    let known: Vec<&Row> = v
-        .rows
-        .iter()
-        .filter(|r| r.known_deviation.is_some())
-        .collect();
+    let known: Vec<&Row> = known_deviations(v).collect();
     if !known.is_empty() {
         s.push_str("\n## Known deviations\n\n");
         for r in known {
@@ -448,11 +444,7 @@ pub fn html(v: &Validation) -> String {
         );
     }
     s.push_str("</tbody>\n</table>\n");
-    let known: Vec<&Row> = v
-        .rows
-        .iter()
-        .filter(|r| r.known_deviation.is_some())
-        .collect();
+    let known: Vec<&Row> = known_deviations(v).collect();
     if !known.is_empty() {
         s.push_str("<h2>Known deviations</h2>\n<dl>\n");
         for r in known {
@@ -467,6 +459,11 @@ pub fn html(v: &Validation) -> String {
     }
     s.push_str("</body>\n</html>\n");
     s
+}
+
+/// The rows out of band that are listed as known deviations.
+fn known_deviations(v: &Validation) -> impl Iterator<Item = &Row> {
+    v.rows.iter().filter(|r| r.known_deviation.is_some())
 }
 
 #[cfg(test)]
