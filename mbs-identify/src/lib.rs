@@ -11,6 +11,8 @@
 
 mod camera;
 mod dataset;
+pub mod lm;
+pub mod noise;
 
 pub use camera::Camera;
 pub use dataset::{Dataset, DatasetError, MarkerSpec, Role, RunData, RunSpec, SCHEMA_VERSION};

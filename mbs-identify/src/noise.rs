@@ -1,0 +1,1 @@
+//! Noise floor and outliers (in progress).
