@@ -9,7 +9,7 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// The dataset schema this crate reads.
 pub const SCHEMA_VERSION: u64 = 1;
@@ -46,7 +46,7 @@ impl DatasetError {
 }
 
 /// How a run is used.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Role {
     /// Fitted.
@@ -56,7 +56,7 @@ pub enum Role {
 }
 
 /// A tracked point fixed on a body.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MarkerSpec {
     /// Its name: the CSV columns are `<name>_x_m` and `<name>_y_m`.
@@ -70,7 +70,7 @@ pub struct MarkerSpec {
 }
 
 /// One recorded run.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunSpec {
     /// Its name, unique in the dataset.
@@ -85,7 +85,7 @@ pub struct RunSpec {
 }
 
 /// A dataset: its directory and what `dataset.json` says.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Dataset {
     /// The directory it was read from.
@@ -271,6 +271,45 @@ impl Dataset {
                     ),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// Writes the dataset into `dir` (created if missing): `dataset.json` and, for each run
+    /// with its frames in `runs` (same order as [`Dataset::runs`]), its CSV, lost frames as
+    /// empty cells. Files already in `dir` are replaced: the caller decides whether that is
+    /// allowed.
+    pub fn write(&self, dir: &Path, runs: &[RunData]) -> std::io::Result<()> {
+        use std::fmt::Write as _;
+        if runs.len() != self.runs.len() {
+            return Err(std::io::Error::other(format!(
+                "{} runs of frames for {} runs listed",
+                runs.len(),
+                self.runs.len()
+            )));
+        }
+        std::fs::create_dir_all(dir)?;
+        let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        std::fs::write(dir.join("dataset.json"), json + "\n")?;
+        for (spec, data) in self.runs.iter().zip(runs) {
+            let mut csv = String::from("time_s");
+            for m in &self.markers {
+                let _ = write!(csv, ",{0}_x_m,{0}_y_m", m.name);
+            }
+            csv.push('\n');
+            for (k, t) in data.time_s.iter().enumerate() {
+                let _ = write!(csv, "{t:.7}");
+                for track in &data.positions {
+                    match track.get(k).copied().flatten() {
+                        Some([x, y]) => {
+                            let _ = write!(csv, ",{x:.7},{y:.7}");
+                        }
+                        None => csv.push_str(",,"),
+                    }
+                }
+                csv.push('\n');
+            }
+            std::fs::write(dir.join(&spec.file), csv)?;
         }
         Ok(())
     }

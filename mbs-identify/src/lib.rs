@@ -11,8 +11,12 @@
 
 mod camera;
 mod dataset;
+mod effect;
 pub mod lm;
 pub mod noise;
+mod rng;
 
 pub use camera::Camera;
 pub use dataset::{Dataset, DatasetError, MarkerSpec, Role, RunData, RunSpec, SCHEMA_VERSION};
+pub use effect::{EffectParam, EffectSpec};
+pub use rng::Rng;

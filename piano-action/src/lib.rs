@@ -25,6 +25,7 @@ mod error;
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod geometry_check;
+pub mod identify;
 pub mod measured;
 pub mod param_paths;
 pub mod params;

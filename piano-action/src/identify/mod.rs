@@ -1,0 +1,8 @@
+//! Identification against measured motion, for the piano: the pendulum (swing) test's
+//! model, its library of flange effects, synthetic datasets with hidden effects, and the
+//! diagnosis that finds, names and adds a missing effect (issue 13; the generic parts are
+//! in `mbs-identify`).
+
+pub mod effects;
+pub mod swing_model;
+pub mod synth;
