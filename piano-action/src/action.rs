@@ -294,6 +294,18 @@ impl Action {
                 stop_c,
             )?)?;
         }
+        if !p.effects.is_empty() {
+            let laws = crate::identify::effects::FlangeEffects::from_entries(&p.effects)?;
+            system.add_element(crate::identify::effects::FlangeEffectElement::new(
+                &model,
+                "hammer",
+                laws,
+                reg,
+                h.mass_g * 1e-3,
+                m(h.com_body_mm),
+                h.rest_angle_deg.to_radians(),
+            )?)?;
+        }
         for (joint, torque) in pivots {
             if torque > 0.0 {
                 system.add_element(PivotFriction::new(

@@ -128,6 +128,58 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Find where measured motion and the model disagree, name the missing effect, add it
+    /// and show the gap shrink. Reads a tracked-marker dataset (DIR/dataset.json and one
+    /// CSV per run, schema 1; the `pendulum` swing test for now) and writes
+    /// OUT/report.json, report.md and report.html.
+    Diagnose {
+        /// The dataset's folder.
+        dataset: std::path::PathBuf,
+        /// Where to write the report (created if missing).
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// Also write the corrected parameter file: calibrated values and the named effect
+        /// as `[[effects]]`, for `piano simulate --params FILE`.
+        #[arg(long, value_name = "FILE")]
+        write_params: Option<std::path::PathBuf>,
+        /// Only these effects of the library (comma-separated ids; default: all).
+        #[arg(long)]
+        library: Option<String>,
+        /// Replace a report (and --write-params file) written earlier.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Write a synthetic dataset with a hidden effect (or none) to test `piano diagnose`:
+    /// nuisance mismatches, AR(1) camera noise, exposure, clock offset, outliers and lost
+    /// frames. The truth goes to its own file, which `diagnose` never reads.
+    Synth {
+        /// The experiment (only `pendulum`).
+        #[arg(long, default_value = "pendulum")]
+        experiment: String,
+        /// The hidden effect, `ID[:name=value,...]` (unset parameters take a clearly
+        /// visible value); leave out for none.
+        #[arg(long)]
+        effect: Option<String>,
+        /// The seed: the same seed gives the same dataset.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Release angles (° above horizontal, comma-separated); the first run is fitted,
+        /// the others held out.
+        #[arg(long, default_value = "0,-35", allow_hyphen_values = true)]
+        releases: String,
+        /// Length of each run (s).
+        #[arg(long, default_value_t = 4.0, allow_negative_numbers = true)]
+        duration: f64,
+        /// The dataset's folder.
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// The truth's JSON file (outside the dataset's folder).
+        #[arg(long)]
+        truth: std::path::PathBuf,
+        /// Replace an existing dataset and truth file.
+        #[arg(long)]
+        force: bool,
+    },
     /// Static touchweight (down, up, balance and friction weight at the key front, in gf)
     /// from a slow simulated key descent and ascent.
     Touchweight {
@@ -818,6 +870,112 @@ fn demo_report(params: &ActionParams) -> Result<(), String> {
     write_report(&dirs, &root.join("report.html"), true)
 }
 
+/// `piano diagnose`.
+fn diagnose(
+    params: &piano_action::params::ActionParams,
+    params_file: Option<&std::path::Path>,
+    dataset: &std::path::Path,
+    out: &std::path::Path,
+    write_params: Option<&std::path::Path>,
+    library: Option<&str>,
+    force: bool,
+) -> Result<(), String> {
+    use piano_action::identify::{commands, diagnose::DiagnoseOptions};
+    let source = match params_file {
+        Some(p) => std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?,
+        None => piano_action::params::DEFAULT_PARAMS_TOML.to_string(),
+    };
+    let options = DiagnoseOptions {
+        library: commands::library(library).map_err(|e| e.to_string())?,
+        ..DiagnoseOptions::default()
+    };
+    let bar = indicatif::ProgressBar::new(100);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:30} {msg} ({elapsed})") {
+        bar.set_style(style);
+    }
+    let progress = |msg: &str, fraction: f64| {
+        bar.set_message(msg.to_string());
+        bar.set_position((fraction * 100.0) as u64);
+    };
+    let result = commands::diagnose_to_disk(
+        params,
+        &source,
+        dataset,
+        &options,
+        out,
+        write_params,
+        force,
+        &progress,
+    );
+    bar.finish_and_clear();
+    let (d, written) = result.map_err(|e| e.to_string())?;
+    println!("decision: {}. {}", d.decision, d.summary);
+    let g = &d.gap;
+    println!(
+        "gap (RMS per coordinate): fitted {:.1} -> {:.1} um, held-out {:.1} -> {:.1} um, noise floor {:.1} um",
+        g.before_rms_m * 1e6,
+        g.after_rms_m * 1e6,
+        g.heldout_before_rms_m * 1e6,
+        g.heldout_after_rms_m * 1e6,
+        g.noise_floor_m * 1e6
+    );
+    for c in &d.candidates {
+        println!("  {:<22} dBIC {:>9.1}  {}", c.id, c.delta_bic, c.why);
+    }
+    for p in written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// `piano synth`.
+#[allow(clippy::too_many_arguments)]
+fn synth(
+    params: &piano_action::params::ActionParams,
+    experiment: &str,
+    effect: Option<&str>,
+    seed: u64,
+    releases: &str,
+    duration: f64,
+    out: &std::path::Path,
+    truth: &std::path::Path,
+    force: bool,
+) -> Result<(), String> {
+    use piano_action::identify::{commands, synth};
+    if experiment != "pendulum" {
+        return Err(format!(
+            "option --experiment: '{experiment}': only 'pendulum' can be synthesised"
+        ));
+    }
+    let releases_deg = releases
+        .split(',')
+        .map(|r| {
+            r.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("option --releases: '{r}' is not a number"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let options = synth::SynthOptions {
+        effect: effect
+            .map(synth::parse_effect)
+            .transpose()
+            .map_err(|e| e.to_string())?,
+        seed,
+        releases_deg,
+        duration_s: duration,
+        ..synth::SynthOptions::default()
+    };
+    commands::synth_to_disk(params, &options, out, truth, force).map_err(|e| e.to_string())?;
+    println!(
+        "dataset: {} ({} runs of {duration} s at {} fps)\ntruth: {}",
+        out.display(),
+        options.releases_deg.len(),
+        options.fps,
+        truth.display()
+    );
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or(Command::Demo);
@@ -863,6 +1021,41 @@ fn main() -> ExitCode {
                 write_report(&runs, &out, force)
             }
             Command::Sweep(args) => sweep(&params, args),
+            Command::Diagnose {
+                dataset,
+                out,
+                write_params,
+                library,
+                force,
+            } => diagnose(
+                &params,
+                cli.params.as_deref(),
+                &dataset,
+                &out,
+                write_params.as_deref(),
+                library.as_deref(),
+                force,
+            ),
+            Command::Synth {
+                experiment,
+                effect,
+                seed,
+                releases,
+                duration,
+                out,
+                truth,
+                force,
+            } => synth(
+                &params,
+                &experiment,
+                effect.as_deref(),
+                seed,
+                &releases,
+                duration,
+                &out,
+                &truth,
+                force,
+            ),
             Command::Params { list: false, .. } => {
                 use std::io::Write;
                 let _ = std::io::stdout()

@@ -468,6 +468,11 @@ pub struct ActionParams {
     pub string: StringParams,
     /// Numerical settings.
     pub numerics: NumericsParams,
+    /// Effects added to the model, usually by `piano diagnose --write-params` (none in the
+    /// reference file): `[[effects]]` tables with `id`, `location` and the effect's
+    /// parameters (see [`crate::identify::effects`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<crate::identify::effects::EffectEntry>,
 }
 
 impl ActionParams {
@@ -501,6 +506,9 @@ impl ActionParams {
         let table = toml::Table::try_from(self)
             .map_err(|e| PianoError::params(String::new(), e.to_string()))?;
         check_table("", &table)?;
+        for (i, e) in self.effects.iter().enumerate() {
+            e.validate(&format!("effects[{i}]"))?;
+        }
         let positive = [
             ("key.mass_g", self.key.mass_g),
             ("key.inertia_pivot_kg_m2", self.key.inertia_pivot_kg_m2),

@@ -95,6 +95,18 @@ pub fn swing_sampled(
         params.numerics.pivot_friction_regularization_rad_s,
     );
     system.add_element(PivotFriction::new(&model, "hammer", friction)?.with_reversal_events())?;
+    if !params.effects.is_empty() {
+        let laws = crate::identify::effects::FlangeEffects::from_entries(&params.effects)?;
+        system.add_element(crate::identify::effects::FlangeEffectElement::new(
+            &model,
+            "hammer",
+            laws,
+            params.numerics.pivot_friction_regularization_rad_s,
+            mass,
+            com,
+            hanging,
+        )?)?;
+    }
     let x0 = system.initial_state(0.0, &[release_angle_deg.to_radians()], &[0.0])?;
     let opts = Options {
         output_step: Some(output_step_s),

@@ -24,7 +24,7 @@
 pub mod experiments;
 mod motions;
 pub mod page;
-mod svg;
+pub(crate) mod svg;
 pub mod touches;
 
 use serde::Deserialize;

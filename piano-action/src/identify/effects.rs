@@ -264,3 +264,81 @@ impl FlangeEffects {
         self.load_friction_m > 0.0
     }
 }
+
+/// The flange effects as a force element on a revolute joint whose body hangs on a fixed
+/// pin (the hammer on its flange).
+///
+/// Friction-type effects (Stribeck peak, load friction) act against the motion through the
+/// same `tanh(ω / v_ε)` as the model's pivot friction. The load friction's pin reaction is
+/// the body's own, `m |ω² r + g|` for a centre of mass at `r` from the pin: gravity and
+/// the centripetal load; the tangential term and forces from contacts on the body are left
+/// out, so in the full action it is a lower bound (the pendulum diagnosis uses the whole
+/// reaction, [`super::swing_model`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlangeEffectElement {
+    name: String,
+    coordinate: usize,
+    laws: FlangeEffects,
+    regularization_rad_s: f64,
+    mass_kg: f64,
+    com_m: [f64; 2],
+    angle_offset_rad: f64,
+}
+
+impl FlangeEffectElement {
+    /// The effects `laws` on joint `joint` of `model`; the body's world angle is
+    /// `angle_offset_rad` plus the joint coordinate, its centre of mass at `com_m` (body
+    /// frame, from the pin) and its mass `mass_kg`.
+    pub fn new(
+        model: &mbs_core::Model,
+        joint: &str,
+        laws: FlangeEffects,
+        regularization_rad_s: f64,
+        mass_kg: f64,
+        com_m: [f64; 2],
+        angle_offset_rad: f64,
+    ) -> Result<Self> {
+        Ok(Self {
+            name: format!("flange effects '{joint}'"),
+            coordinate: model.coordinate_id(joint)?,
+            laws,
+            regularization_rad_s,
+            mass_kg,
+            com_m,
+            angle_offset_rad,
+        })
+    }
+
+    /// The torque at angle `q` and rate `omega` of the joint (N·m).
+    pub fn torque(&self, q: f64, omega: f64) -> f64 {
+        let pin = if self.laws.needs_pin_force() {
+            let (s, c) = (self.angle_offset_rad + q).sin_cos();
+            let r = [
+                c * self.com_m[0] - s * self.com_m[1],
+                s * self.com_m[0] + c * self.com_m[1],
+            ];
+            let w2 = omega * omega;
+            self.mass_kg * (w2 * r[0]).hypot(super::swing_model::GRAVITY_M_S2 - w2 * r[1])
+        } else {
+            0.0
+        };
+        self.laws.damping_torque(omega)
+            - (omega / self.regularization_rad_s).tanh() * self.laws.friction_level(omega, pin)
+    }
+}
+
+impl mbs_core::ForceElement for FlangeEffectElement {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn apply(
+        &self,
+        ctx: &mbs_core::ForceContext<'_>,
+        loads: &mut mbs_core::Loads<'_>,
+        _rates: &mut [f64],
+    ) {
+        let k = self.coordinate;
+        loads.add_generalized(k, self.torque(ctx.q[k], ctx.v[k]));
+    }
+}

@@ -3,6 +3,9 @@
 //! diagnosis that finds, names and adds a missing effect (issue 13; the generic parts are
 //! in `mbs-identify`).
 
+pub mod commands;
+pub mod diagnose;
 pub mod effects;
+pub mod report;
 pub mod swing_model;
 pub mod synth;

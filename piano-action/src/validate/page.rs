@@ -385,7 +385,7 @@ pub fn charts(v: &Validation) -> Vec<Chart> {
     ]
 }
 
-const PAGE_STYLE: &str = "body{font-family:sans-serif;margin:24px;color:#222;max-width:1400px}\
+pub(crate) const PAGE_STYLE: &str = "body{font-family:sans-serif;margin:24px;color:#222;max-width:1400px}\
 h1{font-size:22px}h2{font-size:18px;margin-top:28px}\
 table{border-collapse:collapse;font-size:13px}\
 th,td{border-bottom:1px solid #ddd;padding:4px 8px;text-align:left;vertical-align:top}\

@@ -1,0 +1,371 @@
+//! The bounded Levenberg–Marquardt solver: recovery and honest uncertainty on a noisy
+//! exponential, a hard valley (Rosenbrock), bounds, log scale, failing residual
+//! functions, and independence from the thread count.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use mbs_identify::lm::{FitError, FreeParam, LmFit, LmOptions, Stop, levenberg_marquardt};
+
+/// xorshift64* with Gaussian draws by Box–Muller: noise that a seed fixes.
+struct Noise(u64);
+
+impl Noise {
+    fn new(seed: u64) -> Self {
+        Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let bits = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
+        (bits as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn gaussian(&mut self) -> f64 {
+        let (u1, u2) = (self.uniform(), self.uniform());
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
+
+const A_TRUE: f64 = 2.0;
+const B_TRUE: f64 = 0.7;
+const SIGMA: f64 = 0.05;
+
+/// y = a e^{−b t} + σ ε at t = 0, 0.05, …, 9.95.
+fn decay_data(seed: u64) -> Vec<(f64, f64)> {
+    let mut noise = Noise::new(seed);
+    (0..200)
+        .map(|j| {
+            let t = 0.05 * j as f64;
+            (t, A_TRUE * (-B_TRUE * t).exp() + SIGMA * noise.gaussian())
+        })
+        .collect()
+}
+
+/// a linear, b on a log scale, both started well off.
+fn decay_params() -> Vec<FreeParam> {
+    vec![
+        FreeParam::linear("a", 1.0, 0.0, 10.0, 1.0),
+        FreeParam::log("b", 0.2, 1e-3, 100.0),
+    ]
+}
+
+fn fit_decay(data: &[(f64, f64)], options: &LmOptions) -> LmFit {
+    let model = |x: &[f64]| {
+        Ok(data
+            .iter()
+            .map(|&(t, y)| (x[0] * (-x[1] * t).exp() - y) / SIGMA)
+            .collect())
+    };
+    levenberg_marquardt(&decay_params(), model, options).unwrap()
+}
+
+#[test]
+fn a_noisy_exponential_is_recovered_with_an_honest_standard_deviation() {
+    let truth = [A_TRUE, B_TRUE];
+    let seeds = 50;
+    let mut estimates = vec![Vec::new(); 2];
+    let mut reported_sd = [0.0; 2];
+    let mut covered = [0; 2];
+    let mut most_evaluations = 0;
+    for seed in 0..seeds {
+        let fit = fit_decay(&decay_data(seed), &LmOptions::default());
+        assert!(fit.converged, "seed {seed}: {:?}", fit.stop);
+        most_evaluations = most_evaluations.max(fit.evaluations);
+        // Standardised residuals: s² ≈ 1 and the rss near N − k = 198.
+        assert!((fit.rss - 198.0).abs() < 5.0 * (2.0 * 198.0_f64).sqrt());
+        for i in 0..2 {
+            let (v, sd) = (fit.values[i], fit.sd[i]);
+            assert!((v - truth[i]).abs() < 4.0 * sd, "seed {seed}: {v} ± {sd}");
+            estimates[i].push(v);
+            reported_sd[i] += sd / seeds as f64;
+            let [lo, hi] = fit.ci95[i];
+            assert!(lo < v && v < hi);
+            covered[i] += usize::from(lo <= truth[i] && truth[i] <= hi);
+        }
+        // b is on a log scale: its interval is positive and longer above than below.
+        let [lo, hi] = fit.ci95[1];
+        assert!(lo > 0.0 && hi - fit.values[1] > fit.values[1] - lo);
+        assert!(!fit.at_bound[0] && !fit.at_bound[1]);
+    }
+    for i in 0..2 {
+        let mean = estimates[i].iter().sum::<f64>() / seeds as f64;
+        let var = estimates[i].iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (seeds - 1) as f64;
+        let ratio = reported_sd[i] / var.sqrt();
+        eprintln!(
+            "param {i}: reported sd {:.3e}, sd over seeds {:.3e}, ratio {ratio:.3}, CI95 coverage {}/{seeds}",
+            reported_sd[i],
+            var.sqrt(),
+            covered[i]
+        );
+        assert!((0.7..1.3).contains(&ratio), "param {i}: ratio {ratio}");
+        let coverage = covered[i] as f64 / seeds as f64;
+        assert!((0.85..=1.0).contains(&coverage), "param {i}: {coverage}");
+    }
+    // Frugal: a 2-parameter fit from a poor start in a handful of Jacobians.
+    eprintln!("most evaluations over the seeds: {most_evaluations}");
+    assert!(most_evaluations <= 40, "{most_evaluations}");
+}
+
+#[test]
+fn central_differences_give_the_same_optimum_as_forward() {
+    let data = decay_data(7);
+    let forward = fit_decay(&data, &LmOptions::default());
+    let central = fit_decay(
+        &data,
+        &LmOptions {
+            central: true,
+            ..LmOptions::default()
+        },
+    );
+    assert!(central.converged);
+    for i in 0..2 {
+        assert!((forward.values[i] - central.values[i]).abs() < 1e-3 * forward.sd[i]);
+        assert!((forward.sd[i] / central.sd[i] - 1.0).abs() < 1e-3);
+    }
+}
+
+#[test]
+fn rosenbrock_converges_to_its_minimum() {
+    let params = [
+        FreeParam::linear("x", -1.2, -5.0, 5.0, 1.0),
+        FreeParam::linear("y", 1.0, -5.0, 5.0, 1.0),
+    ];
+    let rosenbrock = |p: &[f64]| Ok(vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]]);
+    let fit = levenberg_marquardt(&params, rosenbrock, &LmOptions::default()).unwrap();
+    eprintln!(
+        "rosenbrock: {:?} after {} iterations, {} evaluations, {:?}",
+        fit.values, fit.iterations, fit.evaluations, fit.stop
+    );
+    assert!(fit.converged);
+    assert!((fit.values[0] - 1.0).abs() < 1e-6 && (fit.values[1] - 1.0).abs() < 1e-6);
+    assert!(fit.rss < 1e-12);
+    // Zero residual at the optimum: s² = 0/0 is not defined (N = k).
+    assert!(fit.covariance.is_none() && fit.sd.iter().all(|v| v.is_nan()));
+    // The step tolerance sets the accuracy.
+    let tight = LmOptions {
+        step_tolerance: 1e-10,
+        ..LmOptions::default()
+    };
+    let fit = levenberg_marquardt(&params, rosenbrock, &tight).unwrap();
+    assert!(fit.converged);
+    assert!((fit.values[0] - 1.0).abs() < 1e-9 && (fit.values[1] - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_parameter_whose_truth_is_below_its_bound_sits_on_it() {
+    // y = 1 − 0.5 t, fitted with y = a + c t and c ≥ 0: c ends at 0, and a at the mean
+    // of y, which is the best a can do with c = 0. Forward differences, and central ones
+    // (one-sided 3-point at the bound).
+    let ts: Vec<f64> = (0..50).map(|j| 0.1 * j as f64).collect();
+    let ys: Vec<f64> = ts.iter().map(|t| 1.0 - 0.5 * t).collect();
+    let mean = ys.iter().sum::<f64>() / ys.len() as f64;
+    for central in [false, true] {
+        let options = LmOptions {
+            central,
+            ..LmOptions::default()
+        };
+        let params = [
+            FreeParam::linear("a", 0.0, -10.0, 10.0, 1.0),
+            FreeParam::linear("c", 1.0, 0.0, 5.0, 1.0),
+        ];
+        let model = |x: &[f64]| {
+            Ok(ts
+                .iter()
+                .zip(&ys)
+                .map(|(t, y)| x[0] + x[1] * t - y)
+                .collect())
+        };
+        let fit = levenberg_marquardt(&params, model, &options).unwrap();
+        assert!(fit.converged, "{:?}", fit.stop);
+        assert_eq!(fit.values[1], 0.0);
+        assert!(fit.at_bound[1] && !fit.at_bound[0]);
+        // To the cost tolerance: the misfit of the missing slope is large, and 1e-6 of it
+        // is a small fraction of a's SD.
+        let (a, sd_a) = (fit.values[0], fit.sd[0]);
+        assert!((a - mean).abs() < 0.01 * sd_a, "{a} ± {sd_a} vs {mean}");
+        // Its interval is clipped to the bound.
+        assert_eq!(fit.ci95[1][0], 0.0);
+
+        // The same with one parameter only, started at the bound: nothing to do.
+        let single = [FreeParam::linear("c", 0.0, 0.0, 5.0, 1.0)];
+        let line = |x: &[f64]| Ok(ts.iter().map(|t| x[0] * t + 0.5 * t).collect());
+        let fit = levenberg_marquardt(&single, line, &options).unwrap();
+        assert_eq!(fit.stop, Stop::Stationary);
+        assert_eq!(fit.values[0], 0.0);
+        assert!(fit.at_bound[0]);
+        assert_eq!(fit.evaluations, if central { 3 } else { 2 });
+    }
+}
+
+#[test]
+fn a_parameter_without_effect_has_no_covariance_and_does_not_move() {
+    // y = a t with a = 3; b is not in the model.
+    let ts: Vec<f64> = (1..=20).map(f64::from).collect();
+    let params = [
+        FreeParam::linear("a", 1.0, -10.0, 10.0, 1.0),
+        FreeParam::linear("b", 0.5, -10.0, 10.0, 1.0),
+    ];
+    let model = |x: &[f64]| Ok(ts.iter().map(|t| x[0] * t - 3.0 * t + 0.01).collect());
+    let fit = levenberg_marquardt(&params, model, &LmOptions::default()).unwrap();
+    assert!(fit.converged, "{:?}", fit.stop);
+    // Least squares: a = 3 − 0.01 Σt / Σt², to the step tolerance (1e-6 × typical).
+    assert!((fit.values[0] - (3.0 - 0.01 * 210.0 / 2870.0)).abs() < 1e-6);
+    assert_eq!(fit.values[1], 0.5);
+    assert!(fit.covariance.is_none() && fit.sd.iter().all(|v| v.is_nan()));
+}
+
+#[test]
+fn a_rate_on_a_log_scale_crosses_two_decades() {
+    let k_true = 1e-3;
+    let ts: Vec<f64> = (0..100).map(|j| 20.0 * j as f64).collect();
+    let params = [FreeParam::log("rate", 1e-1, 1e-6, 10.0)];
+    let model = |x: &[f64]| {
+        Ok(ts
+            .iter()
+            .map(|t| (-x[0] * t).exp() - (-k_true * t).exp())
+            .collect())
+    };
+    let fit = levenberg_marquardt(&params, model, &LmOptions::default()).unwrap();
+    eprintln!(
+        "log rate: {:e} after {} iterations, {} evaluations",
+        fit.values[0], fit.iterations, fit.evaluations
+    );
+    assert!(fit.converged);
+    assert!(
+        (fit.values[0] / k_true - 1.0).abs() < 1e-6,
+        "{}",
+        fit.values[0]
+    );
+}
+
+#[test]
+fn an_invalid_parameter_is_named() {
+    let good = FreeParam::linear("good", 1.0, 0.0, 2.0, 1.0);
+    let cases = [
+        FreeParam::linear("swapped", 1.0, 2.0, 0.0, 1.0),
+        FreeParam::linear("nan_start", f64::NAN, 0.0, 2.0, 1.0),
+        FreeParam::log("log_at_zero", 1.0, 0.0, 2.0),
+        FreeParam::linear("outside", 3.0, 0.0, 2.0, 1.0),
+        FreeParam::linear("no_typical", 1.0, 0.0, 2.0, 0.0),
+        FreeParam::linear("infinite", 1.0, 0.0, f64::INFINITY, 1.0),
+    ];
+    for bad in cases {
+        let calls = AtomicUsize::new(0);
+        let f = |_: &[f64]| {
+            calls.fetch_add(1, Ordering::Relaxed);
+            Ok(vec![0.0])
+        };
+        let params = [good.clone(), bad.clone()];
+        match levenberg_marquardt(&params, f, &LmOptions::default()) {
+            Err(e @ FitError::InvalidParam { .. }) => {
+                let FitError::InvalidParam { name, .. } = &e else {
+                    unreachable!()
+                };
+                assert_eq!(name, &bad.name);
+                assert!(e.to_string().contains(&bad.name), "{e}");
+            }
+            other => panic!("{}: {other:?}", bad.name),
+        }
+        assert_eq!(calls.load(Ordering::Relaxed), 0);
+    }
+}
+
+#[test]
+fn a_residual_function_failing_past_two_is_stepped_around() {
+    // r = eᡃ − e^1.5: the Gauss–Newton step from 0 lands at 3.5, where the model fails.
+    let failures = AtomicUsize::new(0);
+    let f = |x: &[f64]| {
+        if x[0] > 2.0 {
+            failures.fetch_add(1, Ordering::Relaxed);
+            return Err(format!("no model at {}", x[0]));
+        }
+        Ok(vec![x[0].exp() - 1.5_f64.exp(), 0.5 * (x[0] - 1.5)])
+    };
+    // From 0 (trial steps fail), and from 2 exactly (the forward difference fails and
+    // steps back).
+    for start in [0.0, 2.0] {
+        failures.store(0, Ordering::Relaxed);
+        let params = [FreeParam::linear("x", start, -10.0, 10.0, 1.0)];
+        let fit = levenberg_marquardt(&params, f, &LmOptions::default()).unwrap();
+        assert!(fit.converged, "{start}: {:?}", fit.stop);
+        assert!(
+            (fit.values[0] - 1.5).abs() < 1e-6,
+            "{start}: {}",
+            fit.values[0]
+        );
+        assert!(failures.load(Ordering::Relaxed) > 0, "{start}");
+    }
+}
+
+#[test]
+fn failures_that_cannot_be_stepped_around_are_errors() {
+    let params = [FreeParam::linear("x", 1.0, 0.0, 2.0, 1.0)];
+    let options = LmOptions::default();
+    // At the start.
+    let e = levenberg_marquardt(&params, |_| Err("boom".into()), &options).unwrap_err();
+    assert_eq!(e, FitError::Residuals("boom".into()));
+    let e = levenberg_marquardt(&params, |_| Ok(vec![1.0, f64::NAN]), &options).unwrap_err();
+    assert_eq!(e, FitError::NonFiniteStart { index: 1 });
+    // On both sides of the Jacobian's point.
+    let only_at_start = |x: &[f64]| {
+        if x[0] == 1.0 {
+            Ok(vec![1.0])
+        } else {
+            Err("off".into())
+        }
+    };
+    let e = levenberg_marquardt(&params, only_at_start, &options).unwrap_err();
+    assert!(
+        matches!(&e, FitError::Jacobian { name, .. } if name == "x"),
+        "{e:?}"
+    );
+    // The residual vector changes length.
+    let grows = |x: &[f64]| Ok(vec![x[0]; if x[0] == 1.0 { 3 } else { 4 }]);
+    let e = levenberg_marquardt(&params, grows, &options).unwrap_err();
+    assert_eq!(
+        e,
+        FitError::SizeChanged {
+            expected: 3,
+            found: 4
+        }
+    );
+}
+
+#[test]
+fn no_parameters_is_one_evaluation() {
+    let fit = levenberg_marquardt(&[], |_| Ok(vec![3.0, 4.0]), &LmOptions::default()).unwrap();
+    assert_eq!((fit.rss, fit.evaluations, fit.iterations), (25.0, 1, 0));
+    assert!(fit.converged && fit.values.is_empty());
+}
+
+#[test]
+fn the_thread_count_does_not_change_the_result() {
+    let data = decay_data(3);
+    for central in [false, true] {
+        let fits: Vec<LmFit> = [1, 2, 3, 8]
+            .into_iter()
+            .map(|threads| {
+                let options = LmOptions {
+                    central,
+                    threads,
+                    ..LmOptions::default()
+                };
+                fit_decay(&data, &options)
+            })
+            .collect();
+        let bits = |fit: &LmFit| {
+            let mut b: Vec<u64> = fit.values.iter().map(|v| v.to_bits()).collect();
+            b.extend(fit.residuals.iter().map(|v| v.to_bits()));
+            b.extend(fit.covariance.as_ref().unwrap().iter().map(|v| v.to_bits()));
+            b.push(fit.rss.to_bits());
+            b.push(fit.evaluations as u64);
+            b.push(fit.iterations as u64);
+            b
+        };
+        for fit in &fits[1..] {
+            assert_eq!(bits(fit), bits(&fits[0]), "central {central}");
+        }
+    }
+}

@@ -1,0 +1,184 @@
+//! What `piano synth` and `piano diagnose` do on disk: where they write, what they refuse
+//! to overwrite, and the corrected parameter file.
+
+use std::path::{Path, PathBuf};
+
+use mbs_identify::Dataset;
+
+use super::diagnose::{DiagnoseOptions, Diagnosis, Progress, diagnose};
+use super::effects::{PENDULUM_EFFECTS, library_ids};
+use super::synth::{SynthOptions, synthesize};
+use crate::error::{PianoError, Result};
+use crate::params::ActionParams;
+
+/// Writes a synthetic dataset into `out` and its truth to `truth` (a `.json` file outside
+/// the dataset). Refuses to replace an existing dataset or truth file without `force`.
+pub fn synth_to_disk(
+    params: &ActionParams,
+    options: &SynthOptions,
+    out: &Path,
+    truth: &Path,
+    force: bool,
+) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        return Err(PianoError::option(
+            "--out",
+            format!("{} is a file; name a folder", out.display()),
+        ));
+    }
+    if out.join("dataset.json").exists() && !force {
+        return Err(PianoError::file(
+            &out.join("dataset.json"),
+            "exists; choose another --out, or pass --force to replace the dataset",
+        ));
+    }
+    if truth.extension().and_then(|e| e.to_str()) != Some("json") {
+        return Err(PianoError::option(
+            "--truth",
+            format!(
+                "{}: the truth is written as JSON, name a .json file",
+                truth.display()
+            ),
+        ));
+    }
+    let out_abs = std::path::absolute(out).unwrap_or_else(|_| out.to_path_buf());
+    let truth_abs = std::path::absolute(truth).unwrap_or_else(|_| truth.to_path_buf());
+    if truth_abs.starts_with(&out_abs) {
+        return Err(PianoError::option(
+            "--truth",
+            format!(
+                "{} is inside the dataset folder: keep the truth apart from the data",
+                truth.display()
+            ),
+        ));
+    }
+    if truth.exists() && !force {
+        return Err(PianoError::file(
+            truth,
+            "exists; choose another --truth, or pass --force to replace it",
+        ));
+    }
+    let (dataset, runs, truth_record) = synthesize(params, options)?;
+    dataset
+        .write(out, &runs)
+        .map_err(|e| PianoError::file(out, format!("cannot write the dataset: {e}")))?;
+    let text = serde_json::to_string_pretty(&truth_record)
+        .map_err(|e| PianoError::file(truth, format!("cannot encode: {e}")))?;
+    std::fs::write(truth, text + "\n")
+        .map_err(|e| PianoError::file(truth, format!("cannot write: {e}")))?;
+    Ok(())
+}
+
+/// The library restricted to `ids` (comma-separated; all when `None`).
+pub fn library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::EffectSpec>> {
+    let Some(ids) = ids else {
+        return Ok(PENDULUM_EFFECTS.iter().collect());
+    };
+    ids.split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|id| {
+            super::effects::effect_spec(id).ok_or_else(|| {
+                PianoError::option(
+                    "--library",
+                    format!("no effect '{id}' in the library (known: {})", library_ids()),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Reads the dataset in `dir` and diagnoses it; writes the report into `out` and, if
+/// asked, the corrected parameter file (`source` is the text of the parameter file used,
+/// whose comments are kept).
+#[allow(clippy::too_many_arguments)]
+pub fn diagnose_to_disk(
+    params: &ActionParams,
+    source: &str,
+    dir: &Path,
+    options: &DiagnoseOptions,
+    out: &Path,
+    write_params: Option<&Path>,
+    force: bool,
+    progress: Progress<'_>,
+) -> Result<(Diagnosis, Vec<PathBuf>)> {
+    super::report::check_out_dir(out, force)?;
+    if let Some(p) = write_params {
+        if p.extension().and_then(|e| e.to_str()) != Some("toml") {
+            return Err(PianoError::option(
+                "--write-params",
+                format!("{}: a parameter file ends in .toml", p.display()),
+            ));
+        }
+        if p.exists() && !force {
+            return Err(PianoError::file(
+                p,
+                "exists; choose another --write-params, or pass --force to replace it",
+            ));
+        }
+    }
+    let dataset = Dataset::load(dir).map_err(|e| PianoError::File {
+        path: e.file.clone(),
+        message: e.to_string(),
+    })?;
+    let d = diagnose(params, &dataset, options, progress)?;
+    let mut written = super::report::write_pages(&d, dir, out, force)?;
+    if let Some(p) = write_params {
+        let text = corrected_params(source, &d, dir)?;
+        // The written file must read back and carry what the diagnosis found.
+        ActionParams::from_toml_str(&text)?;
+        std::fs::write(p, text).map_err(|e| PianoError::file(p, format!("cannot write: {e}")))?;
+        written.push(p.to_path_buf());
+    }
+    Ok((d, written))
+}
+
+/// The parameter file `source` with the calibrated inertia and flange friction and the
+/// named effect appended as `[[effects]]`, each value tagged with where it came from.
+pub fn corrected_params(source: &str, d: &Diagnosis, dataset: &Path) -> Result<String> {
+    let tag = format!("[identified] piano diagnose {}", dataset.display());
+    let mut lines: Vec<String> = source.lines().map(str::to_string).collect();
+    let mut section = String::new();
+    for key in ["inertia_com_kg_m2", "pivot_friction_n_m"] {
+        let path = format!("hammer.{key}");
+        let Some(value) = d.calibrated.get(&path) else {
+            continue;
+        };
+        let mut done = false;
+        for line in lines.iter_mut() {
+            let t = line.trim();
+            if t.starts_with('[') {
+                section = t.trim_matches(|c| c == '[' || c == ']').trim().to_string();
+                continue;
+            }
+            let is_key = t.split_once('=').is_some_and(|(k, _)| k.trim() == key);
+            if section == "hammer" && is_key {
+                *line = format!("{key} = {value:.4e}    # {tag}");
+                done = true;
+                break;
+            }
+        }
+        if !done {
+            return Err(PianoError::params(
+                path,
+                "not found in the parameter file, so the calibrated value cannot be written",
+            ));
+        }
+    }
+    let mut text = lines.join("\n");
+    text.push('\n');
+    for e in &d.effects {
+        text.push_str(&format!(
+            "\n[[effects]]    # {} ({})\nid = \"{}\"\nlocation = \"{}\"\n",
+            d.decision, tag, e.id, e.location
+        ));
+        for (name, v) in &e.params {
+            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
+            text.push_str(&format!(
+                "{name} = {v:.4e}    # 95 % {:.3e} to {:.3e}\n",
+                ci[0], ci[1]
+            ));
+        }
+    }
+    Ok(text)
+}

@@ -1,0 +1,1188 @@
+//! `piano diagnose` for the pendulum (swing) test: check the data, calibrate what the
+//! model already has, locate where it disagrees with the measured swing, try each named
+//! effect of the library, decide honestly and measure the gap before and after
+//! (`identification.md` §3; issue 13).
+//!
+//! The data check finds gross tracking errors by a leave-one-out local polynomial and the
+//! noise floor with its AR(1) correlation from the frames themselves. Every fit is output
+//! error: the swing is simulated, filmed by the camera's measurement model (exposure and
+//! clock offset) and compared frame by frame, the residuals standardised by the noise
+//! floor and whitened with its correlation. A candidate effect is kept when the whitened
+//! BIC falls by 10 or more, the worst phase's gap by 20 % or more, the held-out run's gap
+//! by 10 % or more, and its strength is plausible and identified.
+
+use std::collections::BTreeMap;
+
+use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
+use mbs_identify::noise::{self, Ar1, OutlierOptions};
+use mbs_identify::{Camera, Dataset, EffectSpec, Role};
+use serde::Serialize;
+
+use super::effects::{EffectEntry, FlangeEffects, HAMMER_FLANGE, PENDULUM_EFFECTS};
+use super::swing_model::SwingModel;
+use crate::error::{PianoError, Result};
+use crate::params::ActionParams;
+
+/// Whitened-BIC drop a candidate needs [D] `identification.md` §3.6 ("very strong" on
+/// the Kass–Raftery scale).
+pub const DELTA_BIC_MAX: f64 = -10.0;
+/// Two kept candidates closer than this in BIC are ambiguous [D] §3.6.
+pub const AMBIGUITY_BIC: f64 = 6.0;
+/// Least relative fall of the flagged phase's gap [D] §3.6.
+pub const EFFECT_SIZE_MIN: f64 = 0.2;
+/// Least relative fall of the held-out run's gap [D] §3.6.
+pub const HELDOUT_GAIN_MIN: f64 = 0.1;
+/// A held-out gap above this many noise floors after the fix is only partly explained
+/// [D] §3.6 and §6 (the look-alike of U1).
+pub const PARTIAL_FLOORS: f64 = 1.5;
+/// Largest relative SD of a kept effect's strength [D] §3.6.
+pub const IDENTIFIABLE_REL_SD: f64 = 0.3;
+/// A baseline within this many noise floors in every phase explains the data [D].
+pub const EXPLAINED_FLOORS: f64 = 1.5;
+
+/// Options of a diagnosis.
+#[derive(Clone, Debug)]
+pub struct DiagnoseOptions {
+    /// The effects tried (by default the whole pendulum library).
+    pub library: Vec<&'static EffectSpec>,
+    /// Threads for the fits' Jacobians.
+    pub threads: usize,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        Self {
+            library: PENDULUM_EFFECTS.iter().collect(),
+            threads: 2,
+        }
+    }
+}
+
+/// One observed coordinate of one frame.
+#[derive(Clone, Copy, Debug)]
+struct Obs {
+    frame: usize,
+    marker: usize,
+    axis: usize,
+    value: f64,
+    segment_start: bool,
+}
+
+/// A run ready to be fitted.
+#[derive(Clone, Debug)]
+struct Run {
+    id: String,
+    role: Role,
+    release_rad: f64,
+    times: Vec<f64>,
+    obs: Vec<Obs>,
+    lost_frames: usize,
+    outlier_frames: Vec<usize>,
+}
+
+/// The data check's result for the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct DataCheck {
+    /// Noise floor (m): the tracking noise's SD per coordinate, from the frames.
+    pub noise_floor_m: f64,
+    /// Lag-one correlation of the tracking noise.
+    pub rho: f64,
+    /// The dataset's declared noise (m), for comparison.
+    pub declared_sigma_m: f64,
+    /// Per run: frames, lost frames, outlier frames.
+    pub runs: Vec<RunCheck>,
+}
+
+/// One run's data check.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunCheck {
+    /// Its id.
+    pub id: String,
+    /// `fit` or `heldout`.
+    pub role: String,
+    /// Frames.
+    pub frames: usize,
+    /// Frames with a marker lost.
+    pub lost_frames: usize,
+    /// Frames flagged as gross tracking errors (left out of every fit).
+    pub outlier_frames: usize,
+}
+
+/// The model's parameters during a fit: physics, then per run release and clock offset.
+#[derive(Clone, Debug, PartialEq)]
+struct Setting {
+    inertia_com_kg_m2: f64,
+    coulomb_n_m: f64,
+    effect: Option<(&'static EffectSpec, Vec<f64>)>,
+    /// Per fitted run: release (rad), offset (s).
+    runs: Vec<(f64, f64)>,
+}
+
+/// A phase of a run and its gap.
+#[derive(Clone, Debug, Serialize)]
+pub struct Phase {
+    /// `<run>/<phase>`: large, medium or small amplitude, last swings, stopped.
+    pub name: String,
+    /// Start (s).
+    pub t0_s: f64,
+    /// End (s).
+    pub t1_s: f64,
+    /// RMS gap of the baseline (m).
+    pub before_rms_m: f64,
+    /// RMS gap of the corrected model (m).
+    pub after_rms_m: f64,
+}
+
+/// The gap before and after.
+#[derive(Clone, Debug, Serialize)]
+pub struct Gap {
+    /// Noise floor (m).
+    pub noise_floor_m: f64,
+    /// Fitted runs, baseline (m).
+    pub before_rms_m: f64,
+    /// Fitted runs, corrected (m).
+    pub after_rms_m: f64,
+    /// Held-out runs, baseline (m).
+    pub heldout_before_rms_m: f64,
+    /// Held-out runs, corrected (m).
+    pub heldout_after_rms_m: f64,
+    /// Per phase of every run.
+    pub phases: Vec<Phase>,
+    /// The phase with the largest baseline gap against the noise floor.
+    pub flagged_phase: String,
+    /// When the baseline's gap first leaves the noise (s, fitted run), if it does.
+    pub onset_s: Option<f64>,
+}
+
+/// One tried candidate.
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    /// Effect id.
+    pub id: String,
+    /// Whitened BIC against the baseline's.
+    pub delta_bic: f64,
+    /// Fitted runs' RMS gap (m).
+    pub fit_rms_m: f64,
+    /// Held-out runs' RMS gap (m).
+    pub heldout_rms_m: f64,
+    /// Flagged phase's RMS gap (m).
+    pub flagged_rms_m: f64,
+    /// Its fitted parameters.
+    pub params: BTreeMap<String, f64>,
+    /// Their 95 % intervals.
+    pub ci95: BTreeMap<String, [f64; 2]>,
+    /// Whether it passed every rule.
+    pub kept: bool,
+    /// Why it was kept or dropped.
+    pub why: String,
+}
+
+/// A named effect of the decision.
+#[derive(Clone, Debug, Serialize)]
+pub struct NamedEffect {
+    /// Its id.
+    pub id: String,
+    /// Where it acts.
+    pub location: String,
+    /// Its parameters.
+    pub params: BTreeMap<String, f64>,
+    /// Their 95 % intervals.
+    pub ci95: BTreeMap<String, [f64; 2]>,
+}
+
+/// The diagnosis (`report.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Diagnosis {
+    /// `named`, `ambiguous`, `none` or `unexplained`.
+    pub decision: String,
+    /// One sentence on why.
+    pub summary: String,
+    /// The effect(s) added (one when named; the best of the set when ambiguous).
+    pub effects: Vec<NamedEffect>,
+    /// The other effects an ambiguity could not separate from the first.
+    pub ambiguous_with: Vec<String>,
+    /// The experiment that would separate them.
+    pub separating_experiment: Option<String>,
+    /// Every candidate tried.
+    pub candidates: Vec<Candidate>,
+    /// Calibrated parameters by path (with the effect when one is added).
+    pub calibrated: BTreeMap<String, f64>,
+    /// The gap.
+    pub gap: Gap,
+    /// The data check.
+    pub data: DataCheck,
+    /// The traces for the report's plots (not in `report.json`).
+    #[serde(skip)]
+    pub traces: Vec<RunTrace>,
+}
+
+/// Measured, baseline and corrected positions of one marker coordinate of a run, for the
+/// plots.
+#[derive(Clone, Debug)]
+pub struct RunTrace {
+    /// The run.
+    pub run: String,
+    /// Fitted or held out.
+    pub heldout: bool,
+    /// Frame times (s) of the valid frames.
+    pub t: Vec<f64>,
+    /// Measured head-marker y (m).
+    pub measured: Vec<f64>,
+    /// Baseline's (m).
+    pub baseline: Vec<f64>,
+    /// Corrected model's (m).
+    pub corrected: Vec<f64>,
+}
+
+/// Progress messages: the stage and its fraction of the whole.
+pub type Progress<'a> = &'a (dyn Fn(&str, f64) + Sync);
+
+/// Everything a fit needs, shared by every stage.
+struct Problem<'a> {
+    params: &'a ActionParams,
+    dataset: &'a Dataset,
+    runs: Vec<Run>,
+    noise: Ar1,
+    threads: usize,
+}
+
+impl Problem<'_> {
+    fn model(&self, s: &Setting) -> Result<SwingModel> {
+        // The parameter file's own effects stay; the candidate adds to them.
+        let mut entries = self.params.effects.clone();
+        if let Some((spec, values)) = &s.effect {
+            entries.push(entry(spec, values));
+        }
+        let effects = FlangeEffects::from_entries(&entries)?;
+        let mut m = SwingModel::from_params(self.params, effects);
+        m.inertia_com_kg_m2 = s.inertia_com_kg_m2;
+        m.coulomb_n_m = s.coulomb_n_m;
+        Ok(m)
+    }
+
+    /// Predicted values of run `r`'s observations.
+    fn predict(&self, model: &SwingModel, r: &Run, release: f64, offset: f64) -> Vec<f64> {
+        self.predict_until(model, r, release, offset, f64::INFINITY)
+    }
+
+    /// Predicted values of run `r`'s observations in frames up to `horizon` (s).
+    fn predict_until(
+        &self,
+        model: &SwingModel,
+        r: &Run,
+        release: f64,
+        offset: f64,
+        horizon: f64,
+    ) -> Vec<f64> {
+        let camera = Camera {
+            exposure_s: self.dataset.exposure_s,
+            offset_s: offset,
+        };
+        let n = frames_until(r, horizon);
+        let end = r.times[..n].last().copied().unwrap_or(0.0) + self.dataset.exposure_s + 0.01;
+        let path = model.simulate(release, end.max(0.01));
+        let tracks: Vec<Vec<[f64; 2]>> = self
+            .dataset
+            .markers
+            .iter()
+            .map(|m| path.frames(&camera, &r.times[..n], m.local_m))
+            .collect();
+        r.obs
+            .iter()
+            .filter(|o| o.frame < n)
+            .map(|o| tracks[o.marker][o.frame][o.axis])
+            .collect()
+    }
+
+    /// Whitened standardised residuals of run `r` (the observations up to `horizon`).
+    fn whitened(&self, r: &Run, predicted: &[f64], horizon: f64) -> Vec<f64> {
+        let n = frames_until(r, horizon);
+        let obs = r.obs.iter().filter(|o| o.frame < n);
+        let std: Vec<f64> = obs
+            .clone()
+            .zip(predicted)
+            .map(|(o, p)| (o.value - p) / self.noise.sigma)
+            .collect();
+        let starts: Vec<bool> = obs.map(|o| o.segment_start).collect();
+        noise::whiten(&std, &starts, self.noise.rho)
+    }
+
+    fn fit_runs(&self) -> impl Iterator<Item = &Run> {
+        self.runs.iter().filter(|r| r.role == Role::Fit)
+    }
+
+    fn heldout_runs(&self) -> impl Iterator<Item = &Run> {
+        self.runs.iter().filter(|r| r.role == Role::Heldout)
+    }
+}
+
+/// Number of frames of `r` up to `horizon` (s).
+fn frames_until(r: &Run, horizon: f64) -> usize {
+    r.times.partition_point(|&t| t <= horizon)
+}
+
+fn entry(spec: &EffectSpec, values: &[f64]) -> EffectEntry {
+    EffectEntry {
+        id: spec.id.to_string(),
+        location: HAMMER_FLANGE.to_string(),
+        params: spec
+            .params
+            .iter()
+            .zip(values)
+            .map(|(p, v)| (p.name.to_string(), *v))
+            .collect(),
+    }
+}
+
+/// Reads a dataset's runs, checks them for the pendulum and finds lost frames and
+/// outliers.
+fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
+    let file = dataset.dir.join("dataset.json");
+    let data_err = |e: mbs_identify::DatasetError| PianoError::File {
+        path: e.file.clone(),
+        message: e.to_string(),
+    };
+    if dataset.experiment != "pendulum" {
+        return Err(PianoError::File {
+            path: file,
+            message: format!(
+                "field `experiment`: '{}': `piano diagnose` knows the 'pendulum' experiment",
+                dataset.experiment
+            ),
+        });
+    }
+    dataset.check_bodies(&["hammer"]).map_err(data_err)?;
+    let mut runs = Vec::new();
+    for (i, spec) in dataset.runs.iter().enumerate() {
+        let release = spec
+            .conditions
+            .get("release_angle_deg")
+            .and_then(|v| v.as_f64())
+            .filter(|v| v.is_finite() && (-90.0..=90.0).contains(v))
+            .ok_or_else(|| PianoError::File {
+                path: file.clone(),
+                message: format!(
+                    "field `runs[{i}].conditions.release_angle_deg`: a pendulum run needs its \
+                     release angle (° above horizontal, −90 to 90)"
+                ),
+            })?;
+        let data = dataset.read_run(spec).map_err(data_err)?;
+        let channels: Vec<Vec<Option<f64>>> = data
+            .positions
+            .iter()
+            .flat_map(|track| (0..2).map(move |a| track.iter().map(|p| p.map(|p| p[a])).collect()))
+            .collect();
+        let refs: Vec<&[Option<f64>]> = channels.iter().map(Vec::as_slice).collect();
+        let outliers = noise::detect_outliers(&data.time_s, &refs, &OutlierOptions::default());
+        let mut obs = Vec::new();
+        for (m, track) in data.positions.iter().enumerate() {
+            for axis in 0..2 {
+                let mut prev_ok = false;
+                for (k, p) in track.iter().enumerate() {
+                    match p {
+                        Some(p) if !outliers[k] => {
+                            obs.push(Obs {
+                                frame: k,
+                                marker: m,
+                                axis,
+                                value: p[axis],
+                                segment_start: !prev_ok,
+                            });
+                            prev_ok = true;
+                        }
+                        _ => prev_ok = false,
+                    }
+                }
+            }
+        }
+        let lost = (0..data.time_s.len())
+            .filter(|&k| data.positions.iter().any(|t| t[k].is_none()))
+            .count();
+        runs.push(Run {
+            id: spec.id.clone(),
+            role: spec.role,
+            release_rad: release.to_radians(),
+            times: data.time_s,
+            obs,
+            lost_frames: lost,
+            outlier_frames: (0..outliers.len()).filter(|&k| outliers[k]).collect(),
+        });
+        let _ = channels;
+    }
+    if !runs.iter().any(|r| r.role == Role::Fit) {
+        return Err(PianoError::File {
+            path: file,
+            message: "field `runs`: no run has role \"fit\"".into(),
+        });
+    }
+    // The noise floor from the frames themselves, outliers left out.
+    let mut all: Vec<Vec<Option<f64>>> = Vec::new();
+    let mut excluded: Vec<bool> = Vec::new();
+    for r in &runs {
+        let n = r.times.len();
+        let mut chans = vec![vec![None; n]; 2 * dataset.markers.len()];
+        for o in &r.obs {
+            chans[2 * o.marker + o.axis][o.frame] = Some(o.value);
+        }
+        // Runs are joined with a gap so no difference spans two runs.
+        for c in chans {
+            let mut c = c;
+            c.extend([None; 4]);
+            all.push(c);
+        }
+        let _ = &mut excluded;
+    }
+    let width = all.iter().map(Vec::len).max().unwrap_or(0);
+    let mut padded: Vec<Vec<Option<f64>>> = all;
+    for c in &mut padded {
+        c.resize(width, None);
+    }
+    let refs: Vec<&[Option<f64>]> = padded.iter().map(Vec::as_slice).collect();
+    let noise =
+        noise::estimate_ar1(&refs, &vec![false; width]).ok_or_else(|| PianoError::File {
+            path: file,
+            message: "too few frames to estimate the tracking noise".into(),
+        })?;
+    Ok((runs, noise))
+}
+
+/// A fitted setting and what the fit says about it.
+struct Fitted {
+    setting: Setting,
+    fit: LmFit,
+    /// Whitened BIC on the fitted runs.
+    bic: f64,
+}
+
+impl Problem<'_> {
+    /// Free parameters of a fit of `effect` started at `start` (the effect's values in
+    /// `start.effect`).
+    fn free_params(&self, start: &Setting) -> Vec<FreeParam> {
+        let h = &self.params.hammer;
+        let mut p = vec![
+            FreeParam::log(
+                "hammer.inertia_com_kg_m2",
+                start.inertia_com_kg_m2,
+                h.inertia_com_kg_m2 / 3.0,
+                h.inertia_com_kg_m2 * 3.0,
+            ),
+            FreeParam::log("hammer.pivot_friction_n_m", start.coulomb_n_m, 1e-6, 2e-2),
+        ];
+        if let Some((spec, values)) = &start.effect {
+            for (e, v) in spec.params.iter().zip(values) {
+                let name = format!("effects.{}.{}", spec.id, e.name);
+                // The search range is wider than the plausible one, so an implausible fit
+                // shows as such instead of sitting on the bound.
+                let hi = 4.0 * e.range[1];
+                p.push(if e.log_scale {
+                    FreeParam::log(&name, *v, e.range[0], e.range[1])
+                } else {
+                    FreeParam::linear(&name, *v, e.range[0], hi, e.typical)
+                });
+            }
+        }
+        let frame = 1.0 / self.dataset.fps;
+        for ((release, offset), r) in start.runs.iter().zip(self.fit_runs()) {
+            p.push(FreeParam::linear(
+                &format!("{}.release_rad", r.id),
+                *release,
+                r.release_rad - 1f64.to_radians(),
+                r.release_rad + 1f64.to_radians(),
+                1e-3,
+            ));
+            p.push(FreeParam::linear(
+                &format!("{}.offset_s", r.id),
+                *offset,
+                -1.5 * frame,
+                1.5 * frame,
+                0.1 * frame,
+            ));
+        }
+        p
+    }
+
+    /// The setting of parameter vector `x` laid out as [`Problem::free_params`].
+    fn setting_of(&self, template: &Setting, x: &[f64]) -> Setting {
+        let mut s = template.clone();
+        s.inertia_com_kg_m2 = x[0];
+        s.coulomb_n_m = x[1];
+        let mut i = 2;
+        if let Some((_, values)) = &mut s.effect {
+            for v in values.iter_mut() {
+                *v = x[i];
+                i += 1;
+            }
+        }
+        for run in &mut s.runs {
+            *run = (x[i], x[i + 1]);
+            i += 2;
+        }
+        s
+    }
+
+    /// Output-error fit from `start` on the fitted runs, by continuation: first the
+    /// first second of each run, then two, then all, each fit starting from the last. A
+    /// swing fitted whole from a start a few per cent off can lock onto the wrong number
+    /// of swings before the hammer sticks; the first second has no such minimum.
+    fn fit(&self, start: &Setting) -> Result<Fitted> {
+        let mut s = start.clone();
+        for horizon in [1.0, 2.0] {
+            s = self.fit_until(&s, horizon)?.setting;
+        }
+        self.fit_until(&s, f64::INFINITY)
+    }
+
+    /// Output-error fit from `start` on the fitted runs' frames up to `horizon` (s).
+    fn fit_until(&self, start: &Setting, horizon: f64) -> Result<Fitted> {
+        let free = self.free_params(start);
+        let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
+            let s = self.setting_of(start, x);
+            let model = self.model(&s).map_err(|e| e.to_string())?;
+            let mut out = Vec::new();
+            for (r, (release, offset)) in self.fit_runs().zip(&s.runs) {
+                let pred = self.predict_until(&model, r, *release, *offset, horizon);
+                out.extend(self.whitened(r, &pred, horizon));
+            }
+            Ok(out)
+        };
+        let options = LmOptions {
+            threads: self.threads,
+            // The residuals are standardised: the RSS is about their number, so the
+            // default relative tolerance would stop short of the optimum.
+            cost_tolerance: 1e-9,
+            ..LmOptions::default()
+        };
+        let fit = levenberg_marquardt(&free, residuals, &options)
+            .map_err(|e| PianoError::Simulation(format!("calibration: {e}")))?;
+        let n = fit.residuals.len() as f64;
+        let k = free.len() as f64;
+        let bic = n * (fit.rss / n).ln() + k * n.ln();
+        Ok(Fitted {
+            setting: self.setting_of(start, &fit.values),
+            fit,
+            bic,
+        })
+    }
+
+    /// Raw residuals (m) of run `r` under `model`, its release and offset refitted (the
+    /// physics held): how a held-out run is judged.
+    fn refit_run(&self, model: &SwingModel, r: &Run) -> Result<Vec<f64>> {
+        let frame = 1.0 / self.dataset.fps;
+        let free = [
+            FreeParam::linear(
+                "release_rad",
+                r.release_rad,
+                r.release_rad - 1f64.to_radians(),
+                r.release_rad + 1f64.to_radians(),
+                1e-3,
+            ),
+            FreeParam::linear("offset_s", 0.0, -1.5 * frame, 1.5 * frame, 0.1 * frame),
+        ];
+        let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
+            Ok(self.whitened(r, &self.predict(model, r, x[0], x[1]), f64::INFINITY))
+        };
+        let options = LmOptions {
+            threads: self.threads,
+            // The residuals are standardised: the RSS is about their number, so the
+            // default relative tolerance would stop short of the optimum.
+            cost_tolerance: 1e-9,
+            ..LmOptions::default()
+        };
+        let fit = levenberg_marquardt(&free, residuals, &options)
+            .map_err(|e| PianoError::Simulation(format!("held-out fit: {e}")))?;
+        Ok(self.raw(model, r, fit.values[0], fit.values[1]))
+    }
+
+    /// Raw residuals (m) of run `r`.
+    fn raw(&self, model: &SwingModel, r: &Run, release: f64, offset: f64) -> Vec<f64> {
+        let pred = self.predict(model, r, release, offset);
+        r.obs.iter().zip(&pred).map(|(o, p)| o.value - p).collect()
+    }
+}
+
+fn rms(v: impl IntoIterator<Item = f64>) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for x in v {
+        s += x * x;
+        n += 1;
+    }
+    if n == 0 { 0.0 } else { (s / n as f64).sqrt() }
+}
+
+/// The phases of a swing from its simulation: large, medium and small amplitude (above
+/// 2/3, 1/3 and below 1/3 of the release amplitude), the last two half swings before the
+/// hammer sticks, and stopped. Empty phases are left out.
+fn swing_phases(model: &SwingModel, release: f64, end: f64) -> Vec<(&'static str, f64, f64)> {
+    let path = model.simulate(release, end);
+    // Hanging: the gravity torque vanishes with the centre of mass below the pin.
+    let [cx, cy] = model.com_m;
+    let hanging = -std::f64::consts::FRAC_PI_2 - cy.atan2(cx);
+    let a0 = (release - hanging).abs().max(1e-9);
+    let mut bounds: Vec<(f64, f64)> = vec![(0.0, a0)];
+    bounds.extend(
+        path.reversals
+            .iter()
+            .map(|&(t, p)| (t, (p - hanging).abs())),
+    );
+    let stop = path.stuck.map(|s| s.0);
+    let n_half = bounds.len() - 1 + usize::from(stop.is_none());
+    let mut phases: Vec<(&'static str, f64, f64)> = Vec::new();
+    let mut push = |name: &'static str, t0: f64, t1: f64| {
+        if t1 <= t0 {
+            return;
+        }
+        match phases.last_mut() {
+            Some(last) if last.0 == name => last.2 = t1,
+            _ => phases.push((name, t0, t1)),
+        }
+    };
+    for i in 0..n_half {
+        let (t0, amp) = bounds[i];
+        let t1 = bounds.get(i + 1).map_or(end, |b| b.0);
+        let name = if stop.is_some() && i + 2 >= n_half {
+            "last swings"
+        } else if amp > 2.0 / 3.0 * a0 {
+            "large amplitude"
+        } else if amp > a0 / 3.0 {
+            "medium amplitude"
+        } else {
+            "small amplitude"
+        };
+        push(name, t0, t1.min(end));
+    }
+    if let Some(ts) = stop {
+        push("stopped", ts, end);
+    }
+    phases
+}
+
+/// A candidate's fit and its scores.
+struct Tried {
+    spec: &'static EffectSpec,
+    fitted: Fitted,
+    model: SwingModel,
+    fit_raw: Vec<Vec<f64>>,
+    heldout_raw: Vec<Vec<f64>>,
+    candidate: Candidate,
+}
+
+/// Diagnoses `dataset` against the hammer of `params`.
+pub fn diagnose(
+    params: &ActionParams,
+    dataset: &Dataset,
+    options: &DiagnoseOptions,
+    progress: Progress<'_>,
+) -> Result<Diagnosis> {
+    progress("checking the data", 0.0);
+    let (runs, noise) = prepare(dataset)?;
+    let problem = Problem {
+        params,
+        dataset,
+        runs,
+        noise,
+        threads: options.threads.max(1),
+    };
+    let sigma = noise.sigma;
+    let data = DataCheck {
+        noise_floor_m: sigma,
+        rho: noise.rho,
+        declared_sigma_m: dataset
+            .markers
+            .iter()
+            .map(|m| m.sigma_m)
+            .fold(0.0, f64::max),
+        runs: problem
+            .runs
+            .iter()
+            .map(|r| RunCheck {
+                id: r.id.clone(),
+                role: match r.role {
+                    Role::Fit => "fit".into(),
+                    Role::Heldout => "heldout".into(),
+                },
+                frames: r.times.len(),
+                lost_frames: r.lost_frames,
+                outlier_frames: r.outlier_frames.len(),
+            })
+            .collect(),
+    };
+    let steps = 2.0 + options.library.len() as f64;
+
+    // A. The baseline: inertia, Coulomb friction, each fitted run's release and offset;
+    // three starts around the parameter file's friction.
+    progress("calibrating the baseline", 1.0 / steps);
+    let h = &params.hammer;
+    let mut baseline: Option<Fitted> = None;
+    for scale in [1.0, 0.8, 1.25] {
+        let start = Setting {
+            inertia_com_kg_m2: h.inertia_com_kg_m2,
+            coulomb_n_m: h.pivot_friction_n_m * scale,
+            effect: None,
+            runs: problem.fit_runs().map(|r| (r.release_rad, 0.0)).collect(),
+        };
+        let f = problem.fit(&start)?;
+        if baseline.as_ref().is_none_or(|b| f.fit.rss < b.fit.rss) {
+            baseline = Some(f);
+        }
+    }
+    let baseline = baseline.ok_or_else(|| PianoError::Simulation("no baseline fit".into()))?;
+    let base_model = problem.model(&baseline.setting)?;
+    let fit_raw = |model: &SwingModel, s: &Setting| -> Vec<Vec<f64>> {
+        problem
+            .fit_runs()
+            .zip(&s.runs)
+            .map(|(r, (rel, off))| problem.raw(model, r, *rel, *off))
+            .collect()
+    };
+    let base_fit_raw = fit_raw(&base_model, &baseline.setting);
+    let base_heldout_raw: Vec<Vec<f64>> = problem
+        .heldout_runs()
+        .map(|r| problem.refit_run(&base_model, r))
+        .collect::<Result<_>>()?;
+
+    // B. Where the baseline disagrees: the phases of every run, the flagged one (largest
+    // gap against the noise floor, fitted runs) and the onset.
+    struct PhaseWindow {
+        run: usize,
+        name: String,
+        t0: f64,
+        t1: f64,
+    }
+    let mut windows = Vec::new();
+    for (i, r) in problem.runs.iter().enumerate() {
+        let (release, _) = problem
+            .fit_runs()
+            .position(|f| f.id == r.id)
+            .map_or((r.release_rad, 0.0), |j| baseline.setting.runs[j]);
+        let end = r.times.last().copied().unwrap_or(0.0) + 1.0 / dataset.fps;
+        for (name, t0, t1) in swing_phases(&base_model, release, end) {
+            windows.push(PhaseWindow {
+                run: i,
+                name: format!("{}/{name}", r.id),
+                t0,
+                t1,
+            });
+        }
+    }
+    // Raw residuals of run i under (fit residuals, held-out residuals).
+    let residuals_of = |i: usize, fit: &[Vec<f64>], held: &[Vec<f64>]| -> Vec<f64> {
+        let r = &problem.runs[i];
+        let list = match r.role {
+            Role::Fit => fit,
+            Role::Heldout => held,
+        };
+        let same_role = problem.runs[..i]
+            .iter()
+            .filter(|x| x.role == r.role)
+            .count();
+        list.get(same_role).cloned().unwrap_or_default()
+    };
+    let window_rms = |w: &PhaseWindow, res: &[f64]| -> f64 {
+        let r = &problem.runs[w.run];
+        rms(r
+            .obs
+            .iter()
+            .zip(res)
+            .filter(|(o, _)| (w.t0..w.t1).contains(&r.times[o.frame]))
+            .map(|(_, e)| *e))
+    };
+    let mut flagged: Option<(usize, f64)> = None;
+    for (k, w) in windows.iter().enumerate() {
+        if problem.runs[w.run].role != Role::Fit {
+            continue;
+        }
+        let g = window_rms(w, &residuals_of(w.run, &base_fit_raw, &base_heldout_raw));
+        if flagged.is_none_or(|(_, best)| g > best) {
+            flagged = Some((k, g));
+        }
+    }
+    let (flagged_k, flagged_before) = flagged.unwrap_or((0, 0.0));
+    let flagged_window = windows.get(flagged_k);
+    let flagged_rms = |fit: &[Vec<f64>], held: &[Vec<f64>]| -> f64 {
+        flagged_window.map_or(0.0, |w| window_rms(w, &residuals_of(w.run, fit, held)))
+    };
+    let onset = onset_s(&problem, &base_fit_raw, sigma);
+
+    // C–D. Each candidate of the library, refitted with the baseline's parameters free.
+    let base_fit_rms = rms(base_fit_raw.iter().flatten().copied());
+    let base_held_rms = rms(base_heldout_raw.iter().flatten().copied());
+    let mut tried: Vec<Tried> = Vec::new();
+    for (c, spec) in options.library.iter().enumerate() {
+        progress(&format!("trying {}", spec.id), (2.0 + c as f64) / steps);
+        let mut best: Option<Fitted> = None;
+        for start_values in starts_of(spec) {
+            let start = Setting {
+                effect: Some((*spec, start_values)),
+                ..baseline.setting.clone()
+            };
+            match problem.fit(&start) {
+                Ok(f) if best.as_ref().is_none_or(|b| f.fit.rss < b.fit.rss) => best = Some(f),
+                _ => {}
+            }
+        }
+        let Some(fitted) = best else { continue };
+        let model = problem.model(&fitted.setting)?;
+        let c_fit_raw = fit_raw(&model, &fitted.setting);
+        let c_held_raw: Vec<Vec<f64>> = problem
+            .heldout_runs()
+            .map(|r| problem.refit_run(&model, r))
+            .collect::<Result<_>>()?;
+        let values = fitted
+            .setting
+            .effect
+            .as_ref()
+            .map(|e| e.1.clone())
+            .unwrap_or_default();
+        let mut cand = Candidate {
+            id: spec.id.to_string(),
+            delta_bic: fitted.bic - baseline.bic,
+            fit_rms_m: rms(c_fit_raw.iter().flatten().copied()),
+            heldout_rms_m: rms(c_held_raw.iter().flatten().copied()),
+            flagged_rms_m: flagged_rms(&c_fit_raw, &c_held_raw),
+            params: spec
+                .params
+                .iter()
+                .zip(&values)
+                .map(|(p, v)| (p.name.to_string(), *v))
+                .collect(),
+            ci95: spec
+                .params
+                .iter()
+                .enumerate()
+                .map(|(j, p)| (p.name.to_string(), fitted.fit.ci95[2 + j]))
+                .collect(),
+            kept: false,
+            why: String::new(),
+        };
+        let strength = values.first().copied().unwrap_or(0.0);
+        let strength_sd = fitted.fit.sd.get(2).copied().unwrap_or(f64::NAN);
+        let has_heldout = !c_held_raw.is_empty();
+        let reasons = judge(
+            spec,
+            &values,
+            strength_sd / strength.max(1e-300),
+            &cand,
+            flagged_before,
+            has_heldout.then_some(base_held_rms),
+        );
+        cand.kept = reasons.is_empty();
+        cand.why = if cand.kept {
+            format!(
+                "kept: ΔBIC {:.0}, flagged phase {:.0} % lower{}",
+                cand.delta_bic,
+                100.0 * (1.0 - cand.flagged_rms_m / flagged_before.max(1e-300)),
+                if has_heldout {
+                    format!(
+                        ", held-out {:.0} % lower",
+                        100.0 * (1.0 - cand.heldout_rms_m / base_held_rms.max(1e-300))
+                    )
+                } else {
+                    String::new()
+                }
+            )
+        } else {
+            format!("dropped: {}", reasons.join("; "))
+        };
+        tried.push(Tried {
+            spec,
+            fitted,
+            model,
+            fit_raw: c_fit_raw,
+            heldout_raw: c_held_raw,
+            candidate: cand,
+        });
+    }
+    progress("writing the diagnosis", 1.0);
+
+    // E. The decision.
+    let mut kept: Vec<&Tried> = tried.iter().filter(|t| t.candidate.kept).collect();
+    kept.sort_by(|a, b| a.fitted.bic.total_cmp(&b.fitted.bic));
+    let base_worst_floors = windows
+        .iter()
+        .map(|w| window_rms(w, &residuals_of(w.run, &base_fit_raw, &base_heldout_raw)) / sigma)
+        .fold(0.0, f64::max);
+    let mut ambiguous_with = Vec::new();
+    let mut separating = None;
+    let chosen = kept.first().copied();
+    let (decision, summary) = match chosen {
+        Some(best) => {
+            let rivals: Vec<&Tried> = kept[1..]
+                .iter()
+                .copied()
+                .filter(|t| t.fitted.bic - best.fitted.bic < AMBIGUITY_BIC)
+                .collect();
+            let held_floors = best.candidate.heldout_rms_m / sigma;
+            if !best.heldout_raw.is_empty() && held_floors > PARTIAL_FLOORS {
+                (
+                    "unexplained".to_string(),
+                    format!(
+                        "{} explains the fitted run but the held-out run keeps a gap of {:.1} \
+                         noise floors: something outside the library (or a look-alike)",
+                        best.spec.id, held_floors
+                    ),
+                )
+            } else if rivals.is_empty() {
+                (
+                    "named".to_string(),
+                    format!(
+                        "{}: {}; the gap falls from {:.1} to {:.1} µm",
+                        best.spec.id,
+                        best.spec.summary,
+                        base_fit_rms * 1e6,
+                        best.candidate.fit_rms_m * 1e6
+                    ),
+                )
+            } else {
+                ambiguous_with = rivals.iter().map(|t| t.spec.id.to_string()).collect();
+                separating = Some(best.spec.discriminating_experiment.to_string());
+                (
+                    "ambiguous".to_string(),
+                    format!(
+                        "{} or {}: the data cannot separate them (whitened BIC within {})",
+                        best.spec.id,
+                        ambiguous_with.join(" or "),
+                        AMBIGUITY_BIC
+                    ),
+                )
+            }
+        }
+        None if base_worst_floors <= EXPLAINED_FLOORS => (
+            "none".to_string(),
+            format!(
+                "the baseline explains the data to the noise floor (worst phase {:.2} floors)",
+                base_worst_floors
+            ),
+        ),
+        None => (
+            "unexplained".to_string(),
+            format!(
+                "the baseline misses something in {} ({:.1} noise floors) that no effect of \
+                 the library accounts for",
+                flagged_window.map_or("the data", |w| w.name.as_str()),
+                flagged_before / sigma
+            ),
+        ),
+    };
+    let corrected = match (decision.as_str(), chosen) {
+        ("named" | "ambiguous", Some(t)) => Some(t),
+        _ => None,
+    };
+    let (after_fit, after_held, after_setting) = match corrected {
+        Some(t) => (&t.fit_raw, &t.heldout_raw, &t.fitted.setting),
+        None => (&base_fit_raw, &base_heldout_raw, &baseline.setting),
+    };
+    let phases = windows
+        .iter()
+        .map(|w| Phase {
+            name: w.name.clone(),
+            t0_s: w.t0,
+            t1_s: w.t1,
+            before_rms_m: window_rms(w, &residuals_of(w.run, &base_fit_raw, &base_heldout_raw)),
+            after_rms_m: window_rms(w, &residuals_of(w.run, after_fit, after_held)),
+        })
+        .collect();
+    let gap = Gap {
+        noise_floor_m: sigma,
+        before_rms_m: base_fit_rms,
+        after_rms_m: rms(after_fit.iter().flatten().copied()),
+        heldout_before_rms_m: base_held_rms,
+        heldout_after_rms_m: rms(after_held.iter().flatten().copied()),
+        phases,
+        flagged_phase: flagged_window.map_or(String::new(), |w| w.name.clone()),
+        onset_s: onset,
+    };
+    let mut calibrated = BTreeMap::new();
+    calibrated.insert(
+        "hammer.inertia_com_kg_m2".to_string(),
+        after_setting.inertia_com_kg_m2,
+    );
+    calibrated.insert(
+        "hammer.pivot_friction_n_m".to_string(),
+        after_setting.coulomb_n_m,
+    );
+    for (r, (rel, off)) in problem.fit_runs().zip(&after_setting.runs) {
+        calibrated.insert(format!("{}.release_angle_deg", r.id), rel.to_degrees());
+        calibrated.insert(format!("{}.offset_s", r.id), *off);
+    }
+    let effects: Vec<NamedEffect> = corrected
+        .map(|t| NamedEffect {
+            id: t.spec.id.to_string(),
+            location: HAMMER_FLANGE.to_string(),
+            params: t.candidate.params.clone(),
+            ci95: t.candidate.ci95.clone(),
+        })
+        .into_iter()
+        .collect();
+    for e in &effects {
+        for (name, v) in &e.params {
+            calibrated.insert(format!("effects.{}.{name}", e.id), *v);
+        }
+    }
+    let corrected_model = corrected.map(|t| &t.model);
+    let traces = traces(
+        &problem,
+        &base_model,
+        &baseline.setting,
+        corrected_model.zip(corrected.map(|t| &t.fitted.setting)),
+    )?;
+    Ok(Diagnosis {
+        decision,
+        summary,
+        effects,
+        ambiguous_with,
+        separating_experiment: separating,
+        candidates: tried.into_iter().map(|t| t.candidate).collect(),
+        calibrated,
+        gap,
+        data,
+        traces,
+    })
+}
+
+/// Starting values of a candidate's parameters: the strength at a tenth of its typical
+/// value (inside its range, off the null so it has a gradient), shape parameters over a
+/// grid of decades.
+fn starts_of(spec: &EffectSpec) -> Vec<Vec<f64>> {
+    let mut starts = vec![Vec::new()];
+    for p in spec.params {
+        let choices: Vec<f64> = if p.null.is_some() {
+            vec![0.1 * p.typical]
+        } else {
+            vec![0.2 * p.typical, p.typical, 5.0 * p.typical]
+                .into_iter()
+                .map(|v: f64| v.clamp(p.range[0], p.range[1]))
+                .collect()
+        };
+        starts = starts
+            .into_iter()
+            .flat_map(|s| {
+                choices.iter().map(move |c| {
+                    let mut s = s.clone();
+                    s.push(*c);
+                    s
+                })
+            })
+            .collect();
+    }
+    starts
+}
+
+/// The rules a candidate must pass; the reasons it fails (empty when kept).
+fn judge(
+    spec: &EffectSpec,
+    values: &[f64],
+    strength_rel_sd: f64,
+    c: &Candidate,
+    flagged_before: f64,
+    heldout_before: Option<f64>,
+) -> Vec<String> {
+    let mut why = Vec::new();
+    if c.delta_bic > DELTA_BIC_MAX {
+        why.push(format!("ΔBIC {:.1} > {DELTA_BIC_MAX}", c.delta_bic));
+    }
+    let fall = 1.0 - c.flagged_rms_m / flagged_before.max(1e-300);
+    if fall < EFFECT_SIZE_MIN {
+        why.push(format!(
+            "flagged phase only {:.0} % lower (needs {:.0} %)",
+            100.0 * fall,
+            100.0 * EFFECT_SIZE_MIN
+        ));
+    }
+    if let Some(before) = heldout_before {
+        let gain = 1.0 - c.heldout_rms_m / before.max(1e-300);
+        if gain < HELDOUT_GAIN_MIN {
+            why.push(format!(
+                "held-out run {:.0} % lower (needs {:.0} %)",
+                100.0 * gain,
+                100.0 * HELDOUT_GAIN_MIN
+            ));
+        }
+    }
+    for (p, v) in spec.params.iter().zip(values) {
+        if !(p.range[0]..=p.range[1]).contains(v) {
+            why.push(format!(
+                "{} = {v:.3e} {} outside the plausible [{:.1e}, {:.1e}]",
+                p.name, p.unit, p.range[0], p.range[1]
+            ));
+        }
+    }
+    if !(strength_rel_sd <= IDENTIFIABLE_REL_SD) {
+        why.push(format!(
+            "strength not identified (relative SD {:.2} > {IDENTIFIABLE_REL_SD})",
+            strength_rel_sd
+        ));
+    }
+    why
+}
+
+/// When the baseline's gap first leaves the noise on the fitted runs: the start of the
+/// first 30 ms window whose RMS exceeds twice the noise floor.
+fn onset_s(problem: &Problem<'_>, fit_raw: &[Vec<f64>], sigma: f64) -> Option<f64> {
+    let r = problem.fit_runs().next()?;
+    let res = fit_raw.first()?;
+    let n = r.times.len();
+    let (mut sum, mut count) = (vec![0.0; n], vec![0usize; n]);
+    for (o, e) in r.obs.iter().zip(res) {
+        sum[o.frame] += e * e;
+        count[o.frame] += 1;
+    }
+    let w = ((0.03 * problem.dataset.fps).round() as usize).max(1);
+    let (mut s, mut c) = (0.0, 0usize);
+    for k in 0..n {
+        s += sum[k];
+        c += count[k];
+        if k >= w {
+            s -= sum[k - w];
+            c -= count[k - w];
+        }
+        if k + 1 >= w && c > 0 && (s / c as f64).sqrt() > 2.0 * sigma {
+            return Some(r.times[k + 1 - w]);
+        }
+    }
+    None
+}
+
+/// The head marker's height (the first marker's y), measured and modelled, per run.
+fn traces(
+    problem: &Problem<'_>,
+    base: &SwingModel,
+    base_setting: &Setting,
+    corrected: Option<(&SwingModel, &Setting)>,
+) -> Result<Vec<RunTrace>> {
+    let mut out = Vec::new();
+    for r in &problem.runs {
+        let fitted = |model: &SwingModel, s: &Setting| -> Result<Vec<f64>> {
+            let pred = match problem.fit_runs().position(|f| f.id == r.id) {
+                Some(j) => problem.predict(model, r, s.runs[j].0, s.runs[j].1),
+                None => {
+                    let raw = problem.refit_run(model, r)?;
+                    r.obs.iter().zip(raw).map(|(o, e)| o.value - e).collect()
+                }
+            };
+            Ok(pred)
+        };
+        let b = fitted(base, base_setting)?;
+        let c = match corrected {
+            Some((m, s)) => fitted(m, s)?,
+            None => b.clone(),
+        };
+        let mut t = RunTrace {
+            run: r.id.clone(),
+            heldout: r.role == Role::Heldout,
+            t: Vec::new(),
+            measured: Vec::new(),
+            baseline: Vec::new(),
+            corrected: Vec::new(),
+        };
+        for (i, o) in r.obs.iter().enumerate() {
+            if o.marker == 0 && o.axis == 1 {
+                t.t.push(r.times[o.frame]);
+                t.measured.push(o.value);
+                t.baseline.push(b[i]);
+                t.corrected.push(c[i]);
+            }
+        }
+        out.push(t);
+    }
+    Ok(out)
+}

@@ -1,0 +1,429 @@
+//! The diagnosis's pages: `report.json` (the contract), `report.md` and a self-contained
+//! `report.html` with the overlays, the residuals against the noise band, the gap per
+//! phase and the candidate table.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::diagnose::Diagnosis;
+use crate::error::{PianoError, Result};
+use crate::validate::page::PAGE_STYLE;
+use crate::validate::svg::{Axis, Chart, Corner, Mark, Series, escape};
+
+/// The files `piano diagnose --out DIR` writes.
+pub const FILES: [&str; 3] = ["report.json", "report.md", "report.html"];
+
+/// How each page marks that `piano diagnose` wrote it.
+const GENERATOR: &str = "piano diagnose";
+
+/// Checks `dir` before a diagnosis: not a file; its pages absent, or (with `force`)
+/// pages an earlier `piano diagnose` wrote. Nothing else is ever replaced.
+pub fn check_out_dir(dir: &Path, force: bool) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(PianoError::option(
+            "--out",
+            format!("{} is a file; name a folder", dir.display()),
+        ));
+    }
+    for name in FILES {
+        let path = dir.join(name);
+        if !path.exists() {
+            continue;
+        }
+        let ours = std::fs::read_to_string(&path)
+            .map(|t| t.contains(GENERATOR))
+            .unwrap_or(false);
+        if !ours {
+            return Err(PianoError::file(
+                &path,
+                "exists and was not written by piano diagnose; choose another --out",
+            ));
+        }
+        if !force {
+            return Err(PianoError::file(
+                &path,
+                "exists; choose another --out, or pass --force to replace it",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Writes the three pages of `d` into `dir` (created if missing); returns their paths.
+pub fn write_pages(d: &Diagnosis, dataset: &Path, dir: &Path, force: bool) -> Result<Vec<PathBuf>> {
+    check_out_dir(dir, force)?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| PianoError::file(dir, format!("cannot create the folder: {e}")))?;
+    let mut json = serde_json::to_value(d)
+        .map_err(|e| PianoError::file(dir, format!("cannot encode the report: {e}")))?;
+    if let Some(map) = json.as_object_mut() {
+        map.insert("generator".into(), GENERATOR.into());
+        map.insert("dataset".into(), dataset.display().to_string().into());
+    }
+    let json = serde_json::to_string_pretty(&json)
+        .map_err(|e| PianoError::file(dir, format!("cannot encode the report: {e}")))?;
+    let mut written = Vec::new();
+    for (name, text) in [
+        (FILES[0], json + "\n"),
+        (FILES[1], markdown(d, dataset)),
+        (FILES[2], html(d, dataset)),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text)
+            .map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+fn um(m: f64) -> String {
+    format!("{:.1}", m * 1e6)
+}
+
+/// The readable report.
+pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "<!-- generator: {GENERATOR} -->");
+    let _ = writeln!(s, "# Diagnosis of {}\n", dataset.display());
+    let _ = writeln!(s, "**Decision: {}.** {}\n", d.decision, d.summary);
+    for e in &d.effects {
+        let _ = writeln!(s, "Effect `{}` at `{}`:\n", e.id, e.location);
+        for (name, v) in &e.params {
+            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
+            let _ = writeln!(
+                s,
+                "- `{name}` = {v:.3e} (95 %: {:.3e} to {:.3e})",
+                ci[0], ci[1]
+            );
+        }
+        s.push('\n');
+    }
+    if !d.ambiguous_with.is_empty() {
+        let _ = writeln!(
+            s,
+            "Cannot be told apart from: {}. To separate them: {}.\n",
+            d.ambiguous_with.join(", "),
+            d.separating_experiment.as_deref().unwrap_or("")
+        );
+    }
+    let g = &d.gap;
+    let _ = writeln!(
+        s,
+        "## Gap (RMS of measured − model, per marker coordinate)\n"
+    );
+    let _ = writeln!(
+        s,
+        "Noise floor {} µm (AR(1) ρ = {:.2}, from the frames). Fitted runs: {} → {} µm. \
+         Held-out runs: {} → {} µm. Flagged phase: {}{}.\n",
+        um(g.noise_floor_m),
+        d.data.rho,
+        um(g.before_rms_m),
+        um(g.after_rms_m),
+        um(g.heldout_before_rms_m),
+        um(g.heldout_after_rms_m),
+        g.flagged_phase,
+        g.onset_s.map_or(String::new(), |t| format!(
+            "; the gap leaves the noise at {t:.3} s"
+        ))
+    );
+    let _ = writeln!(
+        s,
+        "| phase | from (s) | to (s) | before (µm) | after (µm) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for p in &g.phases {
+        let _ = writeln!(
+            s,
+            "| {} | {:.3} | {:.3} | {} | {} |",
+            p.name,
+            p.t0_s,
+            p.t1_s,
+            um(p.before_rms_m),
+            um(p.after_rms_m)
+        );
+    }
+    let _ = writeln!(s, "\n## Candidates\n");
+    let _ = writeln!(
+        s,
+        "| effect | ΔBIC (whitened) | fit (µm) | held-out (µm) | kept | why |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    for c in &d.candidates {
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.1} | {} | {} | {} | {} |",
+            c.id,
+            c.delta_bic,
+            um(c.fit_rms_m),
+            um(c.heldout_rms_m),
+            if c.kept { "yes" } else { "no" },
+            c.why
+        );
+    }
+    let _ = writeln!(s, "\n## Calibrated\n");
+    for (path, v) in &d.calibrated {
+        let _ = writeln!(s, "- `{path}` = {v:.6e}");
+    }
+    let _ = writeln!(s, "\n## Data\n");
+    for r in &d.data.runs {
+        let _ = writeln!(
+            s,
+            "- `{}` ({}): {} frames, {} with a marker lost, {} outliers left out",
+            r.id, r.role, r.frames, r.lost_frames, r.outlier_frames
+        );
+    }
+    s
+}
+
+/// Every `step`-th point, so a chart stays light.
+fn thin(t: &[f64], v: impl Iterator<Item = f64>, step: usize) -> Vec<(f64, f64)> {
+    t.iter().copied().zip(v).step_by(step.max(1)).collect()
+}
+
+/// The charts: per run, the head's height and the residuals before and after against the
+/// noise band; then the gap per phase.
+pub fn charts(d: &Diagnosis) -> Vec<Chart> {
+    let mut out = Vec::new();
+    let sigma_um = d.gap.noise_floor_m * 1e6;
+    for tr in &d.traces {
+        let step = (tr.t.len() / 1500).max(1);
+        let end = tr.t.last().copied().unwrap_or(1.0);
+        let role = if tr.heldout { "held out" } else { "fitted" };
+        let (lo, hi) = tr
+            .measured
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        out.push(Chart {
+            title: format!("{} ({role}): head marker height", tr.run),
+            x: Axis::linear(0.0, end, "time (s)"),
+            y: Axis::linear(lo * 1e3 - 2.0, hi * 1e3 + 2.0, "y (mm)"),
+            series: vec![
+                Series {
+                    label: "measured".into(),
+                    color: "#999999",
+                    points: thin(&tr.t, tr.measured.iter().map(|v| v * 1e3), step),
+                    mark: Mark::Dots { filled: true },
+                },
+                Series {
+                    label: "baseline".into(),
+                    color: "#c0392b",
+                    points: thin(&tr.t, tr.baseline.iter().map(|v| v * 1e3), step),
+                    mark: Mark::Line { dashed: true },
+                },
+                Series {
+                    label: "corrected".into(),
+                    color: "#1f77b4",
+                    points: thin(&tr.t, tr.corrected.iter().map(|v| v * 1e3), step),
+                    mark: Mark::Line { dashed: false },
+                },
+            ],
+            legend: Corner::TopRight,
+        });
+        let before: Vec<f64> = tr
+            .measured
+            .iter()
+            .zip(&tr.baseline)
+            .map(|(m, b)| (m - b) * 1e6)
+            .collect();
+        let after: Vec<f64> = tr
+            .measured
+            .iter()
+            .zip(&tr.corrected)
+            .map(|(m, c)| (m - c) * 1e6)
+            .collect();
+        let span = before
+            .iter()
+            .chain(&after)
+            .fold(3.0 * sigma_um, |a, v| a.max(v.abs()));
+        out.push(Chart {
+            title: format!("{} ({role}): residual, head height", tr.run),
+            x: Axis::linear(0.0, end, "time (s)"),
+            y: Axis::linear(-span, span, "measured − model (µm)"),
+            series: vec![
+                Series {
+                    label: "noise floor ±σ".into(),
+                    color: "#dddddd",
+                    points: vec![(0.0, -sigma_um), (end, -sigma_um)],
+                    mark: Mark::Band {
+                        upper: vec![(0.0, sigma_um), (end, sigma_um)],
+                    },
+                },
+                Series {
+                    label: "baseline".into(),
+                    color: "#c0392b",
+                    points: thin(&tr.t, before.into_iter(), step),
+                    mark: Mark::Line { dashed: false },
+                },
+                Series {
+                    label: "corrected".into(),
+                    color: "#1f77b4",
+                    points: thin(&tr.t, after.into_iter(), step),
+                    mark: Mark::Line { dashed: false },
+                },
+            ],
+            legend: Corner::TopRight,
+        });
+    }
+    let n = d.gap.phases.len() as f64;
+    let top = d.gap.phases.iter().fold(2.0 * sigma_um, |a, p| {
+        a.max(p.before_rms_m * 1e6).max(p.after_rms_m * 1e6)
+    });
+    let pts = |f: &dyn Fn(&super::diagnose::Phase) -> f64| {
+        d.gap
+            .phases
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i as f64 + 1.0, f(p) * 1e6))
+            .collect::<Vec<_>>()
+    };
+    out.push(Chart {
+        title: "RMS gap per phase (numbered as in the table)".into(),
+        x: Axis::linear(0.5, n + 0.5, "phase"),
+        y: Axis::log(0.5 * sigma_um.min(top), 1.5 * top, "RMS gap (µm)"),
+        series: vec![
+            Series {
+                label: "noise floor".into(),
+                color: "#999999",
+                points: vec![(0.5, sigma_um), (n + 0.5, sigma_um)],
+                mark: Mark::Line { dashed: true },
+            },
+            Series {
+                label: "before".into(),
+                color: "#c0392b",
+                points: pts(&|p| p.before_rms_m),
+                mark: Mark::Dots { filled: true },
+            },
+            Series {
+                label: "after".into(),
+                color: "#1f77b4",
+                points: pts(&|p| p.after_rms_m),
+                mark: Mark::Dots { filled: false },
+            },
+        ],
+        legend: Corner::TopRight,
+    });
+    out
+}
+
+/// The self-contained HTML page.
+pub fn html(d: &Diagnosis, dataset: &Path) -> String {
+    let mut s = String::new();
+    let title = format!("Diagnosis of {}", dataset.display());
+    let _ = write!(
+        s,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"generator\" content=\"{GENERATOR}\">\n<title>{}</title>\n\
+         <style>{PAGE_STYLE}.decision{{font-size:17px;padding:8px 12px;background:#f4f8fc;border-left:4px solid #1f77b4}}</style>\n\
+         </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n",
+        escape(&title),
+        escape(&title),
+        escape(&d.decision),
+        escape(&d.summary)
+    );
+    for e in &d.effects {
+        let _ = write!(
+            s,
+            "<p>Effect <code>{}</code> at <code>{}</code>: ",
+            escape(&e.id),
+            escape(&e.location)
+        );
+        for (name, v) in &e.params {
+            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
+            let _ = write!(
+                s,
+                "<code>{}</code> = {v:.3e} (95 %: {:.3e} to {:.3e}) ",
+                escape(name),
+                ci[0],
+                ci[1]
+            );
+        }
+        s.push_str("</p>\n");
+    }
+    if let Some(x) = &d.separating_experiment {
+        let _ = writeln!(
+            s,
+            "<p>Cannot be told apart from {}. To separate them: {}.</p>",
+            escape(&d.ambiguous_with.join(", ")),
+            escape(x)
+        );
+    }
+    let g = &d.gap;
+    let _ = writeln!(
+        s,
+        "<p>Noise floor {} µm per coordinate (AR(1) ρ = {:.2}, estimated from the frames). \
+         RMS gap, fitted runs: {} → {} µm; held-out runs: {} → {} µm. Flagged phase: \
+         <b>{}</b>{}.</p>",
+        um(g.noise_floor_m),
+        d.data.rho,
+        um(g.before_rms_m),
+        um(g.after_rms_m),
+        um(g.heldout_before_rms_m),
+        um(g.heldout_after_rms_m),
+        escape(&g.flagged_phase),
+        g.onset_s.map_or(String::new(), |t| format!(
+            "; the gap leaves the noise at {t:.3} s"
+        ))
+    );
+    s.push_str("<h2>Plots</h2>\n<div class=\"charts\">\n");
+    for c in charts(d) {
+        s.push_str(&c.svg());
+        s.push('\n');
+    }
+    s.push_str("</div>\n<h2>Gap per phase</h2>\n<table><thead><tr><th>#</th><th>phase</th><th>from (s)</th><th>to (s)</th><th>before (µm)</th><th>after (µm)</th></tr></thead><tbody>\n");
+    for (i, p) in g.phases.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td class=\"num\">{:.3}</td><td class=\"num\">{:.3}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            i + 1,
+            escape(&p.name),
+            p.t0_s,
+            p.t1_s,
+            um(p.before_rms_m),
+            um(p.after_rms_m)
+        );
+    }
+    s.push_str("</tbody></table>\n<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th></tr></thead><tbody>\n");
+    for c in &d.candidates {
+        let params: Vec<String> = c
+            .params
+            .iter()
+            .map(|(k, v)| format!("{k} = {v:.3e}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "<tr><td><code>{}</code></td><td class=\"num\">{:.1}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"{}\">{}</td><td>{}</td></tr>",
+            escape(&c.id),
+            c.delta_bic,
+            um(c.fit_rms_m),
+            um(c.heldout_rms_m),
+            escape(&params.join(", ")),
+            if c.kept { "in" } else { "out" },
+            if c.kept { "yes" } else { "no" },
+            escape(&c.why)
+        );
+    }
+    s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n<table><tbody>\n");
+    for (path, v) in &d.calibrated {
+        let _ = writeln!(
+            s,
+            "<tr><td><code>{}</code></td><td class=\"num\">{v:.6e}</td></tr>",
+            escape(path)
+        );
+    }
+    s.push_str("</tbody></table>\n<h2>Data</h2>\n<ul>\n");
+    for r in &d.data.runs {
+        let _ = writeln!(
+            s,
+            "<li><code>{}</code> ({}): {} frames, {} with a marker lost, {} outliers left out</li>",
+            escape(&r.id),
+            r.role,
+            r.frames,
+            r.lost_frames,
+            r.outlier_frames
+        );
+    }
+    s.push_str("</ul>\n</body>\n</html>\n");
+    s
+}
