@@ -302,7 +302,7 @@ pub fn charts(d: &Diagnosis) -> Vec<Chart> {
                 mark: Mark::Dots { filled: false },
             },
         ],
-        legend: Corner::TopRight,
+        legend: Corner::BottomLeft,
     });
     out
 }
