@@ -123,6 +123,25 @@ fn diagnose_the_example_dataset() {
     assert!((c / c_true - 1.0).abs() < 0.1, "{c} vs {c_true}");
     let (ok, _, err) = piano(&args);
     assert!(!ok && err.contains("--force"), "{err}");
+    // A page of the user's own, named like ours, is never replaced, even with --force.
+    let mine = dir.join("mine");
+    std::fs::create_dir_all(&mine).expect("folder");
+    std::fs::write(mine.join("report.md"), "my notes\n").expect("write");
+    let (ok, _, err) = piano(&[
+        "diagnose",
+        data.to_str().expect("utf-8"),
+        "--out",
+        mine.to_str().expect("utf-8"),
+        "--force",
+    ]);
+    assert!(
+        !ok && err.contains("not written by piano diagnose"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(mine.join("report.md")).expect("read"),
+        "my notes\n"
+    );
     let (ok, text, err) = piano(&[
         "--params",
         corrected.to_str().expect("utf-8"),

@@ -191,9 +191,14 @@ fn full_matrix() {
         "pivot_stribeck:ds_n_m=1e-4",
         "pivot_load_friction:mu_r_m=5e-4",
     ];
-    let seeds = 0..10u64;
+    // More seeds with PIANO_MATRIX_SEEDS=N.
+    let n: u64 = std::env::var("PIANO_MATRIX_SEEDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(10);
+    let seeds = 0..n;
     let releases = |seed: u64| {
-        if seed % 2 == 0 {
+        if seed.is_multiple_of(2) {
             [0.0, -35.0]
         } else {
             [-35.0, 0.0]
@@ -293,7 +298,8 @@ fn full_matrix() {
         );
     }
     println!(
-        "\nvisible effects: right {right}/{total}, confidently wrong {wrong}/{total}, parameters within 30 % {param_ok}/{right}, flagged gap ≥3× {flag_ok}/{total}, held-out ≥2× {held_ok}/{total}\nnegatives: none {none_ok}/{neg_total}\nweak: wrong name {weak_wrong}/40\noutside the library: named {outside_named}/10"
+        "\nvisible effects: right {right}/{total}, confidently wrong {wrong}/{total}, parameters within 30 % {param_ok}/{right}, flagged gap ≥3× {flag_ok}/{total}, held-out ≥2× {held_ok}/{total}\nnegatives: none {none_ok}/{neg_total}\nweak: wrong name {weak_wrong}/{}\noutside the library: named {outside_named}/{n}",
+        4 * n
     );
     assert!(right * 10 >= total * 9);
     assert!(wrong * 20 <= total);

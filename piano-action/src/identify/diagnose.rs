@@ -213,6 +213,9 @@ pub struct Diagnosis {
     pub candidates: Vec<Candidate>,
     /// Calibrated parameters by path (with the effect when one is added).
     pub calibrated: BTreeMap<String, f64>,
+    /// The paths the baseline calibration frees (each candidate frees its own parameters
+    /// besides, `effects.<id>.<name>`); everything else is the parameter file's.
+    pub calibration_frees: Vec<String>,
     /// The gap.
     pub gap: Gap,
     /// The data check.
@@ -478,14 +481,14 @@ impl Problem<'_> {
         let frame = 1.0 / self.dataset.fps;
         for ((release, offset), r) in start.runs.iter().zip(self.fit_runs()) {
             p.push(FreeParam::linear(
-                &format!("{}.release_rad", r.id),
+                format!("{}.release_angle_deg", r.id),
                 *release,
                 r.release_rad - 1f64.to_radians(),
                 r.release_rad + 1f64.to_radians(),
                 1e-3,
             ));
             p.push(FreeParam::linear(
-                &format!("{}.offset_s", r.id),
+                format!("{}.offset_s", r.id),
                 *offset,
                 -1.5 * frame,
                 1.5 * frame,
@@ -1056,6 +1059,11 @@ pub fn diagnose(
         separating_experiment: separating,
         candidates: tried.into_iter().map(|t| t.candidate).collect(),
         calibrated,
+        calibration_frees: problem
+            .free_params(&baseline.setting)
+            .into_iter()
+            .map(|p| p.name)
+            .collect(),
         gap,
         data,
         traces,
@@ -1132,7 +1140,7 @@ fn judge(
     let strength = values.first().copied().unwrap_or(0.0);
     if strength <= 0.0 {
         why.push("the fit puts its strength at zero".to_string());
-    } else if !(strength_rel_sd <= IDENTIFIABLE_REL_SD) {
+    } else if strength_rel_sd.is_nan() || strength_rel_sd > IDENTIFIABLE_REL_SD {
         why.push(if strength_rel_sd < 1e3 {
             format!(
                 "strength not identified (relative SD {strength_rel_sd:.2} > \

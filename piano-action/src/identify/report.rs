@@ -19,34 +19,18 @@ const GENERATOR: &str = "piano diagnose";
 /// Checks `dir` before a diagnosis: not a file; its pages absent, or (with `force`)
 /// pages an earlier `piano diagnose` wrote. Nothing else is ever replaced.
 pub fn check_out_dir(dir: &Path, force: bool) -> Result<()> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(PianoError::option(
-            "--out",
-            format!("{} is a file; name a folder", dir.display()),
-        ));
+    crate::validate::page::check_pages(dir, &FILES, GENERATOR, &generator_mark, force)
+}
+
+/// How page `name` marks that `piano diagnose` wrote it.
+fn generator_mark(name: &str) -> String {
+    if name.ends_with(".json") {
+        format!("\"generator\": \"{GENERATOR}\"")
+    } else if name.ends_with(".html") {
+        format!("<meta name=\"generator\" content=\"{GENERATOR}\">")
+    } else {
+        format!("<!-- generator: {GENERATOR} -->")
     }
-    for name in FILES {
-        let path = dir.join(name);
-        if !path.exists() {
-            continue;
-        }
-        let ours = std::fs::read_to_string(&path)
-            .map(|t| t.contains(GENERATOR))
-            .unwrap_or(false);
-        if !ours {
-            return Err(PianoError::file(
-                &path,
-                "exists and was not written by piano diagnose; choose another --out",
-            ));
-        }
-        if !force {
-            return Err(PianoError::file(
-                &path,
-                "exists; choose another --out, or pass --force to replace it",
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// Writes the three pages of `d` into `dir` (created if missing); returns their paths.
@@ -83,7 +67,7 @@ fn um(m: f64) -> String {
 /// The readable report.
 pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "<!-- generator: {GENERATOR} -->");
+    let _ = writeln!(s, "{}", generator_mark("report.md"));
     let _ = writeln!(s, "# Diagnosis of {}\n", dataset.display());
     let _ = writeln!(s, "**Decision: {}.** {}\n", d.decision, d.summary);
     for e in &d.effects {
@@ -314,9 +298,10 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
     let _ = write!(
         s,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
-         <meta name=\"generator\" content=\"{GENERATOR}\">\n<title>{}</title>\n\
+         {}\n<title>{}</title>\n\
          <style>{PAGE_STYLE}.decision{{font-size:17px;padding:8px 12px;background:#f4f8fc;border-left:4px solid #1f77b4}}</style>\n\
          </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n",
+        generator_mark("report.html"),
         escape(&title),
         escape(&title),
         escape(&d.decision),

@@ -219,7 +219,7 @@ pub fn synthesize(
                 // A gross error on one marker's x, y or both, ±10 σ.
                 let m = (rng.uniform() * markers.len() as f64) as usize % markers.len();
                 let which = (rng.uniform() * 3.0) as usize;
-                if let Some(p) = positions[m][k].as_mut() {
+                if let Some(Some(p)) = positions[m].get_mut(k) {
                     for (axis, v) in p.iter_mut().enumerate() {
                         if which == 2 || which == axis {
                             let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
@@ -231,7 +231,9 @@ pub fn synthesize(
             }
             if rng.uniform() < options.lost_fraction {
                 let m = (rng.uniform() * markers.len() as f64) as usize % markers.len();
-                positions[m][k] = None;
+                if let Some(slot) = positions[m].get_mut(k) {
+                    *slot = None;
+                }
                 lost.push(k);
             }
         }

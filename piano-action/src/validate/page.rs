@@ -24,24 +24,37 @@ pub const FILES: [&str; 2] = ["validation.md", "validation.html"];
 /// or (with `force`) pages an earlier `piano validate` wrote. Anything else named like
 /// them is never replaced.
 pub fn check_out_dir(dir: &Path, force: bool) -> Result<()> {
+    check_pages(dir, &FILES, GENERATOR, &generator_mark, force)
+}
+
+/// Checks folder `dir` before `command` writes its pages `files` there: not a file; each
+/// page absent, or (with `force`) one `command` wrote earlier (it holds `mark(name)`).
+/// Anything else named like them is never replaced.
+pub(crate) fn check_pages(
+    dir: &Path,
+    files: &[&str],
+    command: &str,
+    mark: &dyn Fn(&str) -> String,
+    force: bool,
+) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(PianoError::option(
             "--out",
             format!("{} is a file; name a folder", dir.display()),
         ));
     }
-    for name in FILES {
+    for name in files {
         let path = dir.join(name);
         if !path.exists() {
             continue;
         }
         let ours = std::fs::read_to_string(&path)
-            .map(|t| t.contains(&generator_mark(name)))
+            .map(|t| t.contains(&mark(name)))
             .unwrap_or(false);
         if !ours {
             return Err(PianoError::file(
                 &path,
-                "exists and was not written by piano validate; choose another --out",
+                format!("exists and was not written by {command}; choose another --out"),
             ));
         }
         if !force {
