@@ -265,7 +265,8 @@ pub fn charts(d: &Diagnosis) -> Vec<Chart> {
     out.push(Chart {
         title: "RMS gap per phase (numbered as in the table)".into(),
         x: Axis::linear(0.5, n + 0.5, "phase"),
-        y: Axis::log(0.5 * sigma_um.min(top), 1.5 * top, "RMS gap (µm)"),
+        // Headroom above the points for the legend.
+        y: Axis::log(0.5 * sigma_um.min(top), 6.0 * top, "RMS gap (µm)"),
         series: vec![
             Series {
                 label: "noise floor".into(),
@@ -286,7 +287,7 @@ pub fn charts(d: &Diagnosis) -> Vec<Chart> {
                 mark: Mark::Dots { filled: false },
             },
         ],
-        legend: Corner::BottomLeft,
+        legend: Corner::TopRight,
     });
     out
 }
