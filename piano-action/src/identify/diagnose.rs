@@ -920,66 +920,70 @@ pub fn diagnose(
     progress("writing the diagnosis", 1.0);
 
     // E. The decision.
-    let mut kept: Vec<&Tried> = tried.iter().filter(|t| t.candidate.kept).collect();
-    kept.sort_by(|a, b| a.fitted.bic.total_cmp(&b.fitted.bic));
+    let kept: Vec<&Tried> = tried.iter().filter(|t| t.candidate.kept).collect();
     let base_worst_floors = windows
         .iter()
         .map(|w| window_rms(w, &residuals_of(w.run, &base_fit_raw, &base_heldout_raw)) / sigma)
         .fold(0.0, f64::max);
+    let contenders: Vec<Contender> = kept
+        .iter()
+        .map(|t| Contender {
+            bic: t.fitted.bic,
+            heldout_floors: (!t.heldout_raw.is_empty())
+                .then(|| t.candidate.heldout_moving_rms_m / sigma),
+        })
+        .collect();
+    let verdict = decide(&contenders, base_worst_floors);
     let mut ambiguous_with = Vec::new();
     let mut separating = None;
-    let chosen = kept.first().copied();
-    let (decision, summary) = match chosen {
-        Some(best) => {
-            let rivals: Vec<&Tried> = kept[1..]
+    let chosen = match &verdict {
+        Verdict::Named(i) | Verdict::Ambiguous(i, _) | Verdict::Partial(i, _) => Some(kept[*i]),
+        Verdict::None | Verdict::Unexplained => None,
+    };
+    let (decision, summary) = match &verdict {
+        Verdict::Partial(i, floors) => (
+            "unexplained".to_string(),
+            format!(
+                "{} explains the fitted run but the held-out run keeps a gap of {floors:.1} \
+                 noise floors before its last swings: something outside the library (or a \
+                 look-alike)",
+                kept[*i].spec.id
+            ),
+        ),
+        Verdict::Named(i) => (
+            "named".to_string(),
+            format!(
+                "{}: {}; the gap falls from {:.1} to {:.1} µm",
+                kept[*i].spec.id,
+                kept[*i].spec.summary,
+                base_fit_rms * 1e6,
+                kept[*i].candidate.fit_rms_m * 1e6
+            ),
+        ),
+        Verdict::Ambiguous(i, rivals) => {
+            ambiguous_with = rivals
                 .iter()
-                .copied()
-                .filter(|t| t.fitted.bic - best.fitted.bic < AMBIGUITY_BIC)
+                .map(|j| kept[*j].spec.id.to_string())
                 .collect();
-            let held_floors = best.candidate.heldout_moving_rms_m / sigma;
-            if !best.heldout_raw.is_empty() && held_floors > PARTIAL_FLOORS {
-                (
-                    "unexplained".to_string(),
-                    format!(
-                        "{} explains the fitted run but the held-out run keeps a gap of {:.1} \
-                         noise floors before its last swings: something outside the library (or a \
-                         look-alike)",
-                        best.spec.id, held_floors
-                    ),
-                )
-            } else if rivals.is_empty() {
-                (
-                    "named".to_string(),
-                    format!(
-                        "{}: {}; the gap falls from {:.1} to {:.1} µm",
-                        best.spec.id,
-                        best.spec.summary,
-                        base_fit_rms * 1e6,
-                        best.candidate.fit_rms_m * 1e6
-                    ),
-                )
-            } else {
-                ambiguous_with = rivals.iter().map(|t| t.spec.id.to_string()).collect();
-                separating = Some(best.spec.discriminating_experiment.to_string());
-                (
-                    "ambiguous".to_string(),
-                    format!(
-                        "{} or {}: the data cannot separate them (whitened BIC within {})",
-                        best.spec.id,
-                        ambiguous_with.join(" or "),
-                        AMBIGUITY_BIC
-                    ),
-                )
-            }
+            separating = Some(kept[*i].spec.discriminating_experiment.to_string());
+            (
+                "ambiguous".to_string(),
+                format!(
+                    "{} or {}: the data cannot separate them (whitened BIC within {})",
+                    kept[*i].spec.id,
+                    ambiguous_with.join(" or "),
+                    AMBIGUITY_BIC
+                ),
+            )
         }
-        None if base_worst_floors <= EXPLAINED_FLOORS => (
+        Verdict::None => (
             "none".to_string(),
             format!(
                 "the baseline explains the data to the noise floor (worst phase {:.2} floors)",
                 base_worst_floors
             ),
         ),
-        None => (
+        Verdict::Unexplained => (
             "unexplained".to_string(),
             format!(
                 "the baseline misses something in {} ({:.1} noise floors) that no effect of \
@@ -1068,6 +1072,62 @@ pub fn diagnose(
         data,
         traces,
     })
+}
+
+/// A candidate that passed every rule, as the decision sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contender {
+    /// Its whitened BIC on the fitted runs.
+    pub bic: f64,
+    /// Its held-out gap in the large swings, in noise floors (`None` without a held-out
+    /// run).
+    pub heldout_floors: Option<f64>,
+}
+
+/// The decision, indices into the contenders.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verdict {
+    /// One effect.
+    Named(usize),
+    /// The best and the others within [`AMBIGUITY_BIC`] of it.
+    Ambiguous(usize, Vec<usize>),
+    /// The best explains the fitted runs but not the held-out one (this many noise
+    /// floors left): a look-alike of something outside the library. Reported as
+    /// `unexplained`.
+    Partial(usize, f64),
+    /// Nothing kept, and the baseline is within [`EXPLAINED_FLOORS`] everywhere.
+    None,
+    /// Nothing kept, and the baseline is not at the noise floor.
+    Unexplained,
+}
+
+/// Decides among the kept candidates (`identification.md` §3.6): the lowest BIC wins;
+/// a held-out gap above [`PARTIAL_FLOORS`] makes it partial; rivals within
+/// [`AMBIGUITY_BIC`] make it ambiguous; with none kept, the baseline's worst phase
+/// (`baseline_worst_floors`) tells `none` from `unexplained`.
+pub fn decide(kept: &[Contender], baseline_worst_floors: f64) -> Verdict {
+    let mut order: Vec<usize> = (0..kept.len()).collect();
+    order.sort_by(|&a, &b| kept[a].bic.total_cmp(&kept[b].bic));
+    let Some(&best) = order.first() else {
+        return if baseline_worst_floors <= EXPLAINED_FLOORS {
+            Verdict::None
+        } else {
+            Verdict::Unexplained
+        };
+    };
+    if let Some(floors) = kept[best].heldout_floors.filter(|f| *f > PARTIAL_FLOORS) {
+        return Verdict::Partial(best, floors);
+    }
+    let rivals: Vec<usize> = order[1..]
+        .iter()
+        .copied()
+        .filter(|&j| kept[j].bic - kept[best].bic < AMBIGUITY_BIC)
+        .collect();
+    if rivals.is_empty() {
+        Verdict::Named(best)
+    } else {
+        Verdict::Ambiguous(best, rivals)
+    }
 }
 
 /// Starting values of a candidate's parameters: the strength at a tenth of its typical
@@ -1223,4 +1283,43 @@ fn traces(
         out.push(t);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(bic: f64, held: Option<f64>) -> Contender {
+        Contender {
+            bic,
+            heldout_floors: held,
+        }
+    }
+
+    #[test]
+    fn the_decision_follows_the_rules() {
+        // Nothing kept: the baseline's worst phase decides.
+        assert_eq!(decide(&[], 1.2), Verdict::None);
+        assert_eq!(decide(&[], 4.0), Verdict::Unexplained);
+        // One clear winner, whatever the order.
+        assert_eq!(
+            decide(&[c(-50.0, Some(1.1)), c(-900.0, Some(1.0))], 9.0),
+            Verdict::Named(1)
+        );
+        // A rival within 6 BIC units: ambiguous, rivals listed.
+        assert_eq!(
+            decide(
+                &[c(-900.0, Some(1.0)), c(-896.0, Some(1.1)), c(-100.0, None)],
+                9.0
+            ),
+            Verdict::Ambiguous(0, vec![1])
+        );
+        // The best leaves the held-out run 2.4 floors off: a look-alike.
+        assert_eq!(
+            decide(&[c(-900.0, Some(2.4)), c(-800.0, Some(1.0))], 9.0),
+            Verdict::Partial(0, 2.4)
+        );
+        // No held-out run: nothing to fail on.
+        assert_eq!(decide(&[c(-900.0, None)], 9.0), Verdict::Named(0));
+    }
 }
