@@ -205,7 +205,7 @@ fn full_matrix() {
         }
     };
     let (mut right, mut wrong, mut total) = (0, 0, 0);
-    let mut param_ok = 0;
+    let (mut param_ok, mut covered) = (0, 0);
     let (mut flag_ok, mut held_ok) = (0, 0);
     println!("case | seed | decision | named | flagged ratio | held-out ratio | parameter errors");
     for e in effects {
@@ -230,6 +230,14 @@ fn full_matrix() {
                     (v / t.params[n] - 1.0).abs() < 0.3
                 });
                 param_ok += usize::from(ok);
+                let inside = d.effects[0]
+                    .ci95
+                    .iter()
+                    .all(|(n, [lo, hi])| (*lo..=*hi).contains(&t.params[n]));
+                covered += usize::from(inside);
+                if !inside {
+                    errs.push(format!("outside the 95 % interval {:?}", d.effects[0].ci95));
+                }
             }
             let fr = flagged_ratio(&d);
             let hr = d.gap.heldout_before_rms_m / d.gap.heldout_after_rms_m;
@@ -298,13 +306,15 @@ fn full_matrix() {
         );
     }
     println!(
-        "\nvisible effects: right {right}/{total}, confidently wrong {wrong}/{total}, parameters within 30 % {param_ok}/{right}, flagged gap ≥3× {flag_ok}/{total}, held-out ≥2× {held_ok}/{total}\nnegatives: none {none_ok}/{neg_total}\nweak: wrong name {weak_wrong}/{}\noutside the library: named {outside_named}/{n}",
+        "\nvisible effects: right {right}/{total}, confidently wrong {wrong}/{total}, parameters within 30 % {param_ok}/{right}, truth inside the 95 % interval {covered}/{right}, flagged gap ≥3× {flag_ok}/{total}, held-out ≥2× {held_ok}/{total}\nnegatives: none {none_ok}/{neg_total}\nweak: wrong name {weak_wrong}/{}\noutside the library: named {outside_named}/{n}",
         4 * n
     );
     assert!(right * 10 >= total * 9);
     assert!(wrong * 20 <= total);
     assert!(none_ok * 10 >= neg_total * 9);
     assert!(param_ok * 10 >= right * 9);
+    // identification.md §5.3: coverage of at least 80 %.
+    assert!(covered * 5 >= right * 4, "coverage {covered}/{right}");
     assert!(flag_ok * 10 >= total * 9 && held_ok * 10 >= total * 9);
     assert_eq!(weak_wrong, 0);
     assert_eq!(outside_named, 0);

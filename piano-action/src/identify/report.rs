@@ -71,7 +71,12 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
     let _ = writeln!(s, "# Diagnosis of {}\n", dataset.display());
     let _ = writeln!(s, "**Decision: {}.** {}\n", d.decision, d.summary);
     for e in &d.effects {
-        let _ = writeln!(s, "Effect `{}` at `{}`:\n", e.id, e.location);
+        let _ = writeln!(
+            s,
+            "Effect `{}` at `{}` (95 % intervals: fit statistics, and for torques the \
+             hammer's weighing tolerance):\n",
+            e.id, e.location
+        );
         for (name, v) in &e.params {
             let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
             let _ = writeln!(
