@@ -166,6 +166,7 @@ impl Dataset {
         let file = dir.join("dataset.json");
         let text = std::fs::read_to_string(&file)
             .map_err(|e| DatasetError::new(&file, "", format!("cannot read: {e}")))?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text).to_string();
         let mut dataset = parse_dataset(&text, &file)?;
         dataset.dir = dir.to_path_buf();
         dataset.check(&file, &text)?;
@@ -320,6 +321,8 @@ impl Dataset {
         let file = self.dir.join(&run.file);
         let text = std::fs::read_to_string(&file)
             .map_err(|e| DatasetError::new(&file, "", format!("cannot read: {e}")))?;
+        // A spreadsheet's "CSV UTF-8" starts with a byte-order mark.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let mut lines = text
             .lines()
             .enumerate()

@@ -908,7 +908,8 @@ fn diagnose(
         &progress,
     );
     bar.finish_and_clear();
-    let (d, written) = result.map_err(|e| e.to_string())?;
+    let outcome = result.map_err(|e| e.to_string())?;
+    let (d, written) = (&outcome.diagnosis, &outcome.written);
     println!("decision: {}. {}", d.decision, d.summary);
     let g = &d.gap;
     println!(
@@ -922,8 +923,17 @@ fn diagnose(
     for c in &d.candidates {
         println!("  {:<22} dBIC {:>9.1}  {}", c.id, c.delta_bic, c.why);
     }
+    if !d.at_bound.is_empty() {
+        eprintln!(
+            "warning: {} ended at the edge of the search range",
+            d.at_bound.join(", ")
+        );
+    }
     for p in written {
         println!("wrote {}", p.display());
+    }
+    if let Some(why) = &outcome.params_refused {
+        eprintln!("note: {why}");
     }
     Ok(())
 }
@@ -967,9 +977,14 @@ fn synth(
     };
     commands::synth_to_disk(params, &options, out, truth, force).map_err(|e| e.to_string())?;
     println!(
-        "dataset: {} ({} runs of {duration} s at {} fps)\ntruth: {}",
+        "dataset: {} ({} run{} of {duration} s at {} fps)\ntruth: {}",
         out.display(),
         options.releases_deg.len(),
+        if options.releases_deg.len() == 1 {
+            ""
+        } else {
+            "s"
+        },
         options.fps,
         truth.display()
     );

@@ -48,6 +48,15 @@ const SUFFIX_UNITS: [(&str, &str); 16] = [
 
 /// The unit of the field `key` (its last path part, without an index).
 fn unit_of(key: &str) -> &'static str {
+    // An effect's parameter (`[[effects]]`) has its unit in the library.
+    if let Some(unit) = crate::identify::effects::PENDULUM_EFFECTS
+        .iter()
+        .flat_map(|e| e.params)
+        .find(|p| p.name == key)
+        .map(|p| p.unit)
+    {
+        return unit;
+    }
     if let Some((_, unit)) = SUFFIX_UNITS.iter().find(|(s, _)| key.ends_with(s)) {
         return unit;
     }

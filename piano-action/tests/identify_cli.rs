@@ -71,6 +71,32 @@ fn synth_is_reproducible_and_keeps_what_exists() {
         !ok && err.contains("cd_n_m_s2") && err.contains("plausible"),
         "{err}"
     );
+    let (ok, _, err) = piano(&[
+        "synth",
+        "--releases",
+        "0,0",
+        "--out",
+        "x",
+        "--truth",
+        "t.json",
+    ]);
+    assert!(
+        !ok && err.contains("--releases") && err.contains("twice"),
+        "{err}"
+    );
+    let (ok, _, err) = piano(&[
+        "synth",
+        "--effect",
+        "air_drag:cd_n_m_s2=1e-6,cd_n_m_s2=2e-6",
+        "--out",
+        "x",
+        "--truth",
+        "t.json",
+    ]);
+    assert!(!ok && err.contains("twice"), "{err}");
+    // The dataset does not give away what is hidden in it.
+    let json = std::fs::read_to_string(ds.join("dataset.json")).expect("dataset.json");
+    assert!(!json.contains("air_drag"), "{json}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -159,6 +185,17 @@ fn diagnose_the_example_dataset() {
         "pivot_viscous,warp_drive",
     ]);
     assert!(!ok && err.contains("warp_drive"), "{err}");
+    for bad in ["", "pivot_viscous,pivot_viscous"] {
+        let (ok, _, err) = piano(&[
+            "diagnose",
+            data.to_str().expect("utf-8"),
+            "--out",
+            dir.join("r4").to_str().expect("utf-8"),
+            "--library",
+            bad,
+        ]);
+        assert!(!ok && err.contains("--library"), "{bad}: {err}");
+    }
     let (ok, _, err) = piano(&[
         "diagnose",
         dir.join("nothing").to_str().expect("utf-8"),

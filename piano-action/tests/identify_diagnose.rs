@@ -332,7 +332,33 @@ fn datasets_the_pendulum_cannot_use_are_refused_by_file_and_field() {
         ..SynthOptions::default()
     };
     let (dataset, runs, _) = synthesize(&params, &options).expect("synth");
-    let cases: [(&str, &str, &str); 4] = [
+    // The clock must count from the release: the same frames shifted by 0.5 s.
+    let dir = scratch("bad-late-clock");
+    let mut late = runs.clone();
+    for t in &mut late[0].time_s {
+        *t += 0.5;
+    }
+    dataset.write(&dir, &late).expect("write");
+    let ds = Dataset::load(&dir).expect("load");
+    let err = diagnose(&params, &ds, &DiagnoseOptions::default(), &|_, _| {})
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        err.contains(".csv") && err.contains("time_s") && err.contains("release"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    let cases: [(&str, &str, &str); 7] = [
+        // The frames say 0°: a declared 5° is a mistake, not physics to fit.
+        (
+            "\"release_angle_deg\": 0.0",
+            "\"release_angle_deg\": 5.0",
+            "runs[0].conditions.release_angle_deg",
+        ),
+        ("\"fps\": 3000.0", "\"fps\": 30.0", "fps"),
+        // A marker 10 mm further out than where it is.
+        ("0.125,", "0.135,", "head_x_m"),
         (
             "\"experiment\": \"pendulum\"",
             "\"experiment\": \"drop\"",
@@ -364,7 +390,10 @@ fn datasets_the_pendulum_cannot_use_are_refused_by_file_and_field() {
                 .map(|e| e.to_string())
                 .unwrap_or_default(),
         };
-        assert!(message.contains("dataset.json"), "{field}: {message}");
+        assert!(
+            message.contains("dataset.json") || message.contains(".csv"),
+            "{field}: {message}"
+        );
         assert!(message.contains(field), "{field}: {message}");
         let _ = std::fs::remove_dir_all(&dir);
     }

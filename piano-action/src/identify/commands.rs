@@ -41,8 +41,28 @@ pub fn synth_to_disk(
             ),
         ));
     }
-    let out_abs = std::path::absolute(out).unwrap_or_else(|_| out.to_path_buf());
-    let truth_abs = std::path::absolute(truth).unwrap_or_else(|_| truth.to_path_buf());
+    // Resolved through links where the folders exist, so a link into the dataset is seen.
+    let resolve = |p: &Path| -> PathBuf {
+        let abs = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        let mut head = abs.clone();
+        let mut tail = Vec::new();
+        while !head.exists() {
+            match (head.file_name().map(|n| n.to_os_string()), head.parent()) {
+                (Some(name), Some(parent)) => {
+                    tail.push(name);
+                    head = parent.to_path_buf();
+                }
+                _ => return abs,
+            }
+        }
+        let mut real = head.canonicalize().unwrap_or(head);
+        for name in tail.into_iter().rev() {
+            real.push(name);
+        }
+        real
+    };
+    let out_abs = resolve(out);
+    let truth_abs = resolve(truth);
     if truth_abs.starts_with(&out_abs) {
         return Err(PianoError::option(
             "--truth",
@@ -74,18 +94,40 @@ pub fn library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::EffectSpe
     let Some(ids) = ids else {
         return Ok(PENDULUM_EFFECTS.iter().collect());
     };
-    ids.split(',')
-        .map(str::trim)
-        .filter(|s| !s.is_empty())
-        .map(|id| {
-            super::effects::effect_spec(id).ok_or_else(|| {
-                PianoError::option(
-                    "--library",
-                    format!("no effect '{id}' in the library (known: {})", library_ids()),
-                )
-            })
-        })
-        .collect()
+    let mut out: Vec<&'static mbs_identify::EffectSpec> = Vec::new();
+    for id in ids.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let spec = super::effects::effect_spec(id).ok_or_else(|| {
+            PianoError::option(
+                "--library",
+                format!("no effect '{id}' in the library (known: {})", library_ids()),
+            )
+        })?;
+        if out.iter().any(|s| s.id == spec.id) {
+            return Err(PianoError::option(
+                "--library",
+                format!("'{id}' is listed twice"),
+            ));
+        }
+        out.push(spec);
+    }
+    if out.is_empty() {
+        return Err(PianoError::option(
+            "--library",
+            format!("names no effect (known: {})", library_ids()),
+        ));
+    }
+    Ok(out)
+}
+
+/// What `piano diagnose` did.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The diagnosis.
+    pub diagnosis: Diagnosis,
+    /// The files written.
+    pub written: Vec<PathBuf>,
+    /// Why the corrected parameter file asked for was not written, if it was not.
+    pub params_refused: Option<String>,
 }
 
 /// Reads the dataset in `dir` and diagnoses it; writes the report into `out` and, if
@@ -101,7 +143,7 @@ pub fn diagnose_to_disk(
     write_params: Option<&Path>,
     force: bool,
     progress: Progress<'_>,
-) -> Result<(Diagnosis, Vec<PathBuf>)> {
+) -> Result<Outcome> {
     super::report::check_out_dir(out, force)?;
     if let Some(p) = write_params {
         if p.extension().and_then(|e| e.to_str()) != Some("toml") {
@@ -117,20 +159,35 @@ pub fn diagnose_to_disk(
             ));
         }
     }
-    let dataset = Dataset::load(dir).map_err(|e| PianoError::File {
-        path: e.file.clone(),
-        message: e.to_string(),
-    })?;
+    let dataset = Dataset::load(dir).map_err(super::diagnose::dataset_error)?;
     let d = diagnose(params, &dataset, options, progress)?;
     let mut written = super::report::write_pages(&d, dir, out, force)?;
-    if let Some(p) = write_params {
+    let refusal = if d.decision == "unexplained" {
+        Some(
+            "no parameter file written: the model does not explain the data, so its \
+             calibrated values are not to be trusted"
+                .to_string(),
+        )
+    } else if !d.at_bound.is_empty() {
+        Some(format!(
+            "no parameter file written: {} ended at the edge of its search range",
+            d.at_bound.join(", ")
+        ))
+    } else {
+        None
+    };
+    if let (Some(p), None) = (write_params, &refusal) {
         let text = corrected_params(source, &d, dir)?;
         // The written file must read back and carry what the diagnosis found.
         ActionParams::from_toml_str(&text)?;
         std::fs::write(p, text).map_err(|e| PianoError::file(p, format!("cannot write: {e}")))?;
         written.push(p.to_path_buf());
     }
-    Ok((d, written))
+    Ok(Outcome {
+        diagnosis: d,
+        written,
+        params_refused: refusal.filter(|_| write_params.is_some()),
+    })
 }
 
 /// The parameter file `source` with the calibrated inertia and flange friction and the
@@ -175,7 +232,7 @@ pub fn corrected_params(source: &str, d: &Diagnosis, dataset: &Path) -> Result<S
         for (name, v) in &e.params {
             let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
             text.push_str(&format!(
-                "{name} = {v:.4e}    # 95 % {:.3e} to {:.3e}\n",
+                "{name} = {v:.4e}    # {tag}; 95 % {:.3e} to {:.3e}\n",
                 ci[0], ci[1]
             ));
         }

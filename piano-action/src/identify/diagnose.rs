@@ -223,6 +223,9 @@ pub struct Diagnosis {
     pub candidates: Vec<Candidate>,
     /// Calibrated parameters by path (with the effect when one is added).
     pub calibrated: BTreeMap<String, f64>,
+    /// Calibrated parameters that ended at the edge of their search range (a sign the
+    /// model or the data is wrong).
+    pub at_bound: Vec<String>,
     /// The paths the baseline calibration frees (each candidate frees its own parameters
     /// besides, `effects.<id>.<name>`); everything else is the parameter file's.
     pub calibration_frees: Vec<String>,
@@ -243,14 +246,19 @@ pub struct RunTrace {
     pub run: String,
     /// Fitted or held out.
     pub heldout: bool,
-    /// Frame times (s) of the valid frames.
+    /// Frame times (s) of the frames where the head marker is seen.
     pub t: Vec<f64>,
-    /// Measured head-marker y (m).
+    /// Measured head-marker height (m).
     pub measured: Vec<f64>,
     /// Baseline's (m).
     pub baseline: Vec<f64>,
-    /// Corrected model's (m).
-    pub corrected: Vec<f64>,
+    /// Corrected model's (m), when an effect was added.
+    pub corrected: Option<Vec<f64>>,
+    /// Measured − baseline along the swing (m): the head marker's residual projected on
+    /// the direction it moves, perpendicular to the pin.
+    pub baseline_residual: Vec<f64>,
+    /// Measured − corrected along the swing (m), when an effect was added.
+    pub corrected_residual: Option<Vec<f64>>,
 }
 
 /// Progress messages: the stage and its fraction of the whole.
@@ -353,14 +361,165 @@ fn entry(spec: &EffectSpec, values: &[f64]) -> EffectEntry {
     }
 }
 
+/// A dataset error as the piano's error: the file, then the line, the field and what is
+/// wrong.
+pub fn dataset_error(e: mbs_identify::DatasetError) -> PianoError {
+    let mut where_ = String::new();
+    if let Some(l) = e.line {
+        where_.push_str(&format!("line {l}, "));
+    }
+    if !e.field.is_empty() {
+        where_.push_str(&format!("field `{}`: ", e.field));
+    }
+    PianoError::File {
+        path: e.file,
+        message: format!("{where_}{}", e.message),
+    }
+}
+
+/// An error about `field` of `file`.
+fn file_error(file: &std::path::Path, field: &str, message: &str) -> PianoError {
+    PianoError::File {
+        path: file.to_path_buf(),
+        message: format!("field `{field}`: {message}"),
+    }
+}
+
+/// Shortest run the swing can be judged on [D]: half a swing of this hammer.
+pub const MIN_RUN_S: f64 = 0.3;
+/// A marker further than this fraction from where `local_m` puts it is misplaced [D]: a
+/// target is placed to a millimetre on a 60–130 mm radius.
+pub const MARKER_RADIUS_TOLERANCE: f64 = 0.05;
+/// The hammer must be seen moving (20 σ from its first position) within this time of
+/// t = 0 (s) [D]: released 10° from hanging it moves 8 mm at the head in 0.1 s.
+pub const RELEASE_WINDOW_S: f64 = 0.1;
+/// Largest difference between the declared release angle and the first frames' (°) [D].
+pub const RELEASE_MISMATCH_DEG: f64 = 2.0;
+
+/// Checks that run `i`'s frames can be a swing released at t = 0 from `declared` (rad)
+/// and filmed with this dataset's markers: frames at the declared rate, long enough, the
+/// markers at their declared distance from the pin, the release at t = 0 and at the
+/// declared angle. Returns the release angle the first frames show (rad).
+fn check_run(
+    dataset: &Dataset,
+    spec: &mbs_identify::RunSpec,
+    i: usize,
+    data: &mbs_identify::RunData,
+    declared: f64,
+) -> Result<f64> {
+    let json = dataset.dir.join("dataset.json");
+    let csv = dataset.dir.join(&spec.file);
+    let t = &data.time_s;
+    let n = t.len();
+    let span = t[n - 1] - t[0];
+    if n < 100 || span < MIN_RUN_S {
+        return Err(file_error(
+            &csv,
+            "time_s",
+            &format!(
+                "{n} frames over {span:.3} s: a swing test needs at least {MIN_RUN_S} s and 100 \
+                 frames"
+            ),
+        ));
+    }
+    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    steps.sort_by(f64::total_cmp);
+    let step = steps[steps.len() / 2];
+    if ((step * dataset.fps) - 1.0).abs() > 0.01 {
+        return Err(file_error(
+            &json,
+            "fps",
+            &format!(
+                "{} frames/s, but the frames of {} are {:.4e} s apart ({:.1} frames/s)",
+                dataset.fps,
+                spec.file,
+                step,
+                1.0 / step
+            ),
+        ));
+    }
+    if t[0] > step {
+        return Err(file_error(
+            &csv,
+            "time_s",
+            &format!(
+                "the first frame is at {} s: time is counted from the release (t = 0; frames \
+                 before it have negative times)",
+                t[0]
+            ),
+        ));
+    }
+    let mut angles = Vec::new();
+    for (m, marker) in dataset.markers.iter().enumerate() {
+        let r_local = marker.local_m[0].hypot(marker.local_m[1]);
+        let mut radii: Vec<f64> = data.positions[m]
+            .iter()
+            .flatten()
+            .map(|p| p[0].hypot(p[1]))
+            .collect();
+        radii.sort_by(f64::total_cmp);
+        let r_seen = radii[radii.len() / 2];
+        if (r_seen / r_local - 1.0).abs() > MARKER_RADIUS_TOLERANCE {
+            return Err(file_error(
+                &csv,
+                &format!("{}_x_m", marker.name),
+                &format!(
+                    "marker '{}' is {r_seen:.4} m from the pin in the frames, but its local_m \
+                     puts it {r_local:.4} m away: positions in metres, origin at the flange's \
+                     centre pin, and each marker's columns its own",
+                    marker.name
+                ),
+            ));
+        }
+        // Where the release is: the first seen frames, and when the marker leaves it.
+        let seen: Vec<(f64, [f64; 2])> = t
+            .iter()
+            .zip(&data.positions[m])
+            .filter_map(|(t, p)| p.map(|p| (*t, p)))
+            .collect();
+        let first = seen[0].1;
+        angles.push(first[1].atan2(first[0]) - marker.local_m[1].atan2(marker.local_m[0]));
+        let moved = seen
+            .iter()
+            .find(|(_, p)| (p[0] - first[0]).hypot(p[1] - first[1]) > 20.0 * marker.sigma_m);
+        if let Some((t_move, _)) = moved
+            && *t_move > RELEASE_WINDOW_S
+        {
+            return Err(file_error(
+                &csv,
+                "time_s",
+                &format!(
+                    "marker '{}' starts moving at {t_move:.3} s: time is counted from the \
+                     release (t = 0); shift the times so the release is at 0",
+                    marker.name
+                ),
+            ));
+        }
+    }
+    let seen = angles.iter().sum::<f64>() / angles.len() as f64;
+    let seen =
+        (seen + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    if (seen - declared).abs().to_degrees() > RELEASE_MISMATCH_DEG {
+        return Err(file_error(
+            &json,
+            &format!("runs[{i}].conditions.release_angle_deg"),
+            &format!(
+                "says {:.1}°, but the first frames of {} show the shank at {:.1}° above \
+                 horizontal",
+                declared.to_degrees(),
+                spec.file,
+                seen.to_degrees()
+            ),
+        ));
+    }
+    Ok(seen)
+}
+
 /// Reads a dataset's runs, checks them for the pendulum and finds lost frames and
 /// outliers.
 fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
     let file = dataset.dir.join("dataset.json");
-    let data_err = |e: mbs_identify::DatasetError| PianoError::File {
-        path: e.file.clone(),
-        message: e.to_string(),
-    };
+    let data_err = dataset_error;
     if dataset.experiment != "pendulum" {
         return Err(PianoError::File {
             path: file,
@@ -373,19 +532,28 @@ fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
     dataset.check_bodies(&["hammer"]).map_err(data_err)?;
     let mut runs = Vec::new();
     for (i, spec) in dataset.runs.iter().enumerate() {
-        let release = spec
-            .conditions
-            .get("release_angle_deg")
-            .and_then(|v| v.as_f64())
-            .filter(|v| v.is_finite() && (-90.0..=90.0).contains(v))
-            .ok_or_else(|| PianoError::File {
-                path: file.clone(),
-                message: format!(
-                    "field `runs[{i}].conditions.release_angle_deg`: a pendulum run needs its \
-                     release angle (° above horizontal, −90 to 90)"
-                ),
-            })?;
+        let field = format!("runs[{i}].conditions.release_angle_deg");
+        let declared = match spec.conditions.get("release_angle_deg") {
+            None => {
+                return Err(file_error(
+                    &file,
+                    &field,
+                    "missing: a pendulum run needs its release angle (° above horizontal)",
+                ));
+            }
+            Some(v) => v.as_f64().filter(|v| v.is_finite()).ok_or_else(|| {
+                file_error(&file, &field, &format!("{v} is not a number of degrees"))
+            })?,
+        };
+        if !(-90.0..=90.0).contains(&declared) {
+            return Err(file_error(
+                &file,
+                &field,
+                &format!("{declared}° is out of range: −90° (hanging straight down) to 90°"),
+            ));
+        }
         let data = dataset.read_run(spec).map_err(data_err)?;
+        let release = check_run(dataset, spec, i, &data, declared.to_radians())?;
         let channels: Vec<Vec<Option<f64>>> = data
             .positions
             .iter()
@@ -420,7 +588,7 @@ fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
         runs.push(Run {
             id: spec.id.clone(),
             role: spec.role,
-            release_rad: release.to_radians(),
+            release_rad: release,
             times: data.time_s,
             obs,
             lost_frames: lost,
@@ -1039,6 +1207,14 @@ pub fn diagnose(
         flagged_phase: flagged_window.map_or(String::new(), |w| w.name.clone()),
         onset_s: onset,
     };
+    let final_fit = corrected.map_or(&baseline, |t| &t.fitted);
+    let at_bound: Vec<String> = problem
+        .free_params(&final_fit.setting)
+        .into_iter()
+        .zip(&final_fit.fit.at_bound)
+        .filter(|(p, at)| **at && !p.name.starts_with("effects."))
+        .map(|(p, _)| p.name)
+        .collect();
     let mut calibrated = BTreeMap::new();
     calibrated.insert(
         "hammer.inertia_com_kg_m2".to_string(),
@@ -1081,6 +1257,7 @@ pub fn diagnose(
         separating_experiment: separating,
         candidates: tried.into_iter().map(|t| t.candidate).collect(),
         calibrated,
+        at_bound,
         calibration_frees: problem
             .free_params(&baseline.setting)
             .into_iter()
@@ -1278,9 +1455,23 @@ fn traces(
             Ok(pred)
         };
         let b = fitted(base, base_setting)?;
-        let c = match corrected {
-            Some((m, s)) => fitted(m, s)?,
-            None => b.clone(),
+        let c = corrected.map(|(m, s)| fitted(m, s)).transpose()?;
+        // Head marker (the first) per frame: measured and modelled x, y.
+        let n = r.times.len();
+        let mut meas = vec![[f64::NAN; 2]; n];
+        let mut base_p = vec![[f64::NAN; 2]; n];
+        let mut corr_p = vec![[f64::NAN; 2]; n];
+        for (i, o) in r.obs.iter().enumerate().filter(|(_, o)| o.marker == 0) {
+            meas[o.frame][o.axis] = o.value;
+            base_p[o.frame][o.axis] = b[i];
+            if let Some(c) = &c {
+                corr_p[o.frame][o.axis] = c[i];
+            }
+        }
+        // The residual along the swing: (Δx, Δy)·(−y, x)/r.
+        let along = |m: [f64; 2], p: [f64; 2]| {
+            let r = m[0].hypot(m[1]);
+            ((m[0] - p[0]) * -m[1] + (m[1] - p[1]) * m[0]) / r
         };
         let mut t = RunTrace {
             run: r.id.clone(),
@@ -1288,14 +1479,21 @@ fn traces(
             t: Vec::new(),
             measured: Vec::new(),
             baseline: Vec::new(),
-            corrected: Vec::new(),
+            corrected: c.as_ref().map(|_| Vec::new()),
+            baseline_residual: Vec::new(),
+            corrected_residual: c.as_ref().map(|_| Vec::new()),
         };
-        for (i, o) in r.obs.iter().enumerate() {
-            if o.marker == 0 && o.axis == 1 {
-                t.t.push(r.times[o.frame]);
-                t.measured.push(o.value);
-                t.baseline.push(b[i]);
-                t.corrected.push(c[i]);
+        for k in 0..n {
+            if !(meas[k][0].is_finite() && meas[k][1].is_finite()) {
+                continue;
+            }
+            t.t.push(r.times[k]);
+            t.measured.push(meas[k][1]);
+            t.baseline.push(base_p[k][1]);
+            t.baseline_residual.push(along(meas[k], base_p[k]));
+            if let (Some(cy), Some(cr)) = (t.corrected.as_mut(), t.corrected_residual.as_mut()) {
+                cy.push(corr_p[k][1]);
+                cr.push(along(meas[k], corr_p[k]));
             }
         }
         out.push(t);

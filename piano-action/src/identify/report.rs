@@ -60,6 +60,15 @@ pub fn write_pages(d: &Diagnosis, dataset: &Path, dir: &Path, force: bool) -> Re
     Ok(written)
 }
 
+/// Where the baseline's gap first leaves the noise, in words.
+fn onset_text(onset_s: Option<f64>) -> String {
+    match onset_s {
+        None => "; the gap stays within twice the noise floor".into(),
+        Some(t) if t < 0.05 => "; the gap exceeds twice the noise floor from the release".into(),
+        Some(t) => format!("; the gap leaves the noise at {t:.3} s"),
+    }
+}
+
 fn um(m: f64) -> String {
     format!("{:.1}", m * 1e6)
 }
@@ -70,6 +79,14 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
     let _ = writeln!(s, "{}", generator_mark("report.md"));
     let _ = writeln!(s, "# Diagnosis of {}\n", dataset.display());
     let _ = writeln!(s, "**Decision: {}.** {}\n", d.decision, d.summary);
+    if !d.at_bound.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Warning:** {} ended at the edge of the search range: check the data and the \
+             parameter file.\n",
+            d.at_bound.join(", ")
+        );
+    }
     for e in &d.effects {
         let _ = writeln!(
             s,
@@ -111,9 +128,7 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
         um(g.heldout_before_rms_m),
         um(g.heldout_after_rms_m),
         g.flagged_phase,
-        g.onset_s.map_or(String::new(), |t| format!(
-            "; the gap leaves the noise at {t:.3} s"
-        ))
+        onset_text(g.onset_s)
     );
     let _ = writeln!(
         s,
@@ -184,74 +199,72 @@ pub fn charts(d: &Diagnosis) -> Vec<Chart> {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
                 (a.min(v), b.max(v))
             });
+        let margin = 0.06 * (hi - lo).max(1e-3);
+        let mut series = vec![
+            Series {
+                label: "measured".into(),
+                color: "#999999",
+                points: thin(&tr.t, tr.measured.iter().map(|v| v * 1e3), step),
+                mark: Mark::Dots { filled: true },
+            },
+            Series {
+                label: "baseline".into(),
+                color: "#c0392b",
+                points: thin(&tr.t, tr.baseline.iter().map(|v| v * 1e3), step),
+                mark: Mark::Line { dashed: true },
+            },
+        ];
+        if let Some(c) = &tr.corrected {
+            series.push(Series {
+                label: "corrected".into(),
+                color: "#1f77b4",
+                points: thin(&tr.t, c.iter().map(|v| v * 1e3), step),
+                mark: Mark::Line { dashed: false },
+            });
+        }
         out.push(Chart {
             title: format!("{} ({role}): head marker height", tr.run),
             x: Axis::linear(0.0, end, "time (s)"),
-            y: Axis::linear(lo * 1e3 - 2.0, hi * 1e3 + 2.0, "y (mm)"),
-            series: vec![
-                Series {
-                    label: "measured".into(),
-                    color: "#999999",
-                    points: thin(&tr.t, tr.measured.iter().map(|v| v * 1e3), step),
-                    mark: Mark::Dots { filled: true },
-                },
-                Series {
-                    label: "baseline".into(),
-                    color: "#c0392b",
-                    points: thin(&tr.t, tr.baseline.iter().map(|v| v * 1e3), step),
-                    mark: Mark::Line { dashed: true },
-                },
-                Series {
-                    label: "corrected".into(),
-                    color: "#1f77b4",
-                    points: thin(&tr.t, tr.corrected.iter().map(|v| v * 1e3), step),
-                    mark: Mark::Line { dashed: false },
-                },
-            ],
+            y: Axis::linear((lo - margin) * 1e3, (hi + 3.0 * margin) * 1e3, "y (mm)"),
+            series,
             legend: Corner::TopRight,
         });
-        let before: Vec<f64> = tr
-            .measured
-            .iter()
-            .zip(&tr.baseline)
-            .map(|(m, b)| (m - b) * 1e6)
-            .collect();
-        let after: Vec<f64> = tr
-            .measured
-            .iter()
-            .zip(&tr.corrected)
-            .map(|(m, c)| (m - c) * 1e6)
-            .collect();
+        let um = |v: &[f64]| v.iter().map(|x| x * 1e6).collect::<Vec<f64>>();
+        let before = um(&tr.baseline_residual);
+        let after = tr.corrected_residual.as_deref().map(um);
         let span = before
             .iter()
-            .chain(&after)
-            .fold(3.0 * sigma_um, |a, v| a.max(v.abs()));
+            .chain(after.iter().flatten())
+            .fold(4.0 * sigma_um, |a, v| a.max(v.abs()));
+        let mut series = vec![
+            Series {
+                label: "noise floor ±σ".into(),
+                color: "#b9d3ea",
+                points: vec![(0.0, -sigma_um), (end, -sigma_um)],
+                mark: Mark::Band {
+                    upper: vec![(0.0, sigma_um), (end, sigma_um)],
+                },
+            },
+            Series {
+                label: "baseline".into(),
+                color: "#c0392b",
+                points: thin(&tr.t, before.into_iter(), step),
+                mark: Mark::Line { dashed: false },
+            },
+        ];
+        if let Some(after) = after {
+            series.push(Series {
+                label: "corrected".into(),
+                color: "#1f77b4",
+                points: thin(&tr.t, after.into_iter(), step),
+                mark: Mark::Line { dashed: false },
+            });
+        }
         out.push(Chart {
-            title: format!("{} ({role}): residual, head height", tr.run),
+            title: format!("{} ({role}): residual along the swing, head", tr.run),
             x: Axis::linear(0.0, end, "time (s)"),
             y: Axis::linear(-span, span, "measured − model (µm)"),
-            series: vec![
-                Series {
-                    label: "noise floor ±σ".into(),
-                    color: "#dddddd",
-                    points: vec![(0.0, -sigma_um), (end, -sigma_um)],
-                    mark: Mark::Band {
-                        upper: vec![(0.0, sigma_um), (end, sigma_um)],
-                    },
-                },
-                Series {
-                    label: "baseline".into(),
-                    color: "#c0392b",
-                    points: thin(&tr.t, before.into_iter(), step),
-                    mark: Mark::Line { dashed: false },
-                },
-                Series {
-                    label: "corrected".into(),
-                    color: "#1f77b4",
-                    points: thin(&tr.t, after.into_iter(), step),
-                    mark: Mark::Line { dashed: false },
-                },
-            ],
+            series,
             legend: Corner::TopRight,
         });
     }
@@ -271,7 +284,7 @@ pub fn charts(d: &Diagnosis) -> Vec<Chart> {
         title: "RMS gap per phase (numbered as in the table)".into(),
         x: Axis::linear(0.5, n + 0.5, "phase"),
         // Headroom above the points for the legend.
-        y: Axis::log(0.5 * sigma_um.min(top), 6.0 * top, "RMS gap (µm)"),
+        y: Axis::log(0.5 * sigma_um.min(top), 20.0 * top, "RMS gap (µm)"),
         series: vec![
             Series {
                 label: "noise floor".into(),
@@ -285,13 +298,15 @@ pub fn charts(d: &Diagnosis) -> Vec<Chart> {
                 points: pts(&|p| p.before_rms_m),
                 mark: Mark::Dots { filled: true },
             },
-            Series {
-                label: "after".into(),
-                color: "#1f77b4",
-                points: pts(&|p| p.after_rms_m),
-                mark: Mark::Dots { filled: false },
-            },
-        ],
+        ]
+        .into_iter()
+        .chain((!d.effects.is_empty()).then(|| Series {
+            label: "after".into(),
+            color: "#1f77b4",
+            points: pts(&|p| p.after_rms_m),
+            mark: Mark::Dots { filled: false },
+        }))
+        .collect(),
         legend: Corner::TopRight,
     });
     out
@@ -313,6 +328,14 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
         escape(&d.decision),
         escape(&d.summary)
     );
+    if !d.at_bound.is_empty() {
+        let _ = writeln!(
+            s,
+            "<p><b>Warning:</b> {} ended at the edge of the search range: check the data and \
+             the parameter file.</p>",
+            escape(&d.at_bound.join(", "))
+        );
+    }
     for e in &d.effects {
         let _ = write!(
             s,
@@ -353,9 +376,7 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
         um(g.heldout_before_rms_m),
         um(g.heldout_after_rms_m),
         escape(&g.flagged_phase),
-        g.onset_s.map_or(String::new(), |t| format!(
-            "; the gap leaves the noise at {t:.3} s"
-        ))
+        onset_text(g.onset_s)
     );
     s.push_str("<h2>Plots</h2>\n<div class=\"charts\">\n");
     for c in charts(d) {

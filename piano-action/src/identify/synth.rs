@@ -131,6 +131,15 @@ fn check(o: &SynthOptions) -> Result<()> {
     if o.releases_deg.is_empty() {
         return bad("--releases", "needs at least one release angle".into());
     }
+    let ids: Vec<String> = o.releases_deg.iter().map(|r| run_id(*r)).collect();
+    for (i, id) in ids.iter().enumerate() {
+        if ids[..i].contains(id) {
+            return bad(
+                "--releases",
+                format!("{}° is listed twice", o.releases_deg[i]),
+            );
+        }
+    }
     for &r in &o.releases_deg {
         if !(r.is_finite() && (-80.0..=60.0).contains(&r)) {
             return bad(
@@ -258,17 +267,13 @@ pub fn synthesize(
             stop_s: path.stuck.map(|s| s.0),
         });
     }
-    let describe = match &options.effect {
-        Some(e) => format!("hidden effect {}", e.id),
-        None => "no hidden effect".into(),
-    };
     let dataset = Dataset {
         dir: Default::default(),
         schema_version: SCHEMA_VERSION,
         experiment: "pendulum".into(),
         description: format!(
-            "synthetic swing test from `piano synth`, seed {} ({describe}; the truth is in \
-             its own file)",
+            "synthetic swing test from `piano synth`, seed {} (what is hidden in it is in \
+             the truth file)",
             options.seed
         ),
         fps: options.fps,
@@ -308,6 +313,7 @@ pub fn parse_effect(text: &str) -> Result<EffectEntry> {
         .iter()
         .map(|p| (p.name.to_string(), p.typical))
         .collect();
+    let mut params_given: Vec<String> = Vec::new();
     for item in rest.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (name, value) = item
             .split_once('=')
@@ -316,6 +322,13 @@ pub fn parse_effect(text: &str) -> Result<EffectEntry> {
             .trim()
             .parse()
             .map_err(|_| PianoError::option("--effect", format!("'{value}' is not a number")))?;
+        if params_given.contains(&name.trim().to_string()) {
+            return Err(PianoError::option(
+                "--effect",
+                format!("'{}' is given twice", name.trim()),
+            ));
+        }
+        params_given.push(name.trim().to_string());
         if spec.param(name.trim()).is_none() {
             return Err(PianoError::option(
                 "--effect",
