@@ -422,7 +422,7 @@ fn parse_dataset(text: &str, file: &Path) -> Result<Dataset, DatasetError> {
     let mut de = serde_json::Deserializer::from_str(text);
     serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let field = match e.path().to_string() {
-            p if p == "." => String::new(),
+            p if p == "." || p == "?" => String::new(),
             p => p,
         };
         let inner = e.inner();
