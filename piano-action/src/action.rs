@@ -175,7 +175,7 @@ impl Action {
 
         // Bodies: mass (kg), centre of mass in the joint frame (m), inertia about it.
         let mut b = ModelBuilder::new();
-        b.gravity([0.0, -9.81]);
+        b.gravity([0.0, -crate::params::GRAVITY_M_S2]);
         let key_com = rel(k.com_mm, k.pivot_mm);
         let key_mass = k.mass_g * 1e-3;
         let key_i = k.inertia_pivot_kg_m2 - key_mass * (key_com[0].powi(2) + key_com[1].powi(2));
@@ -537,7 +537,7 @@ impl Action {
                     Attachment::on("presser", [0.0, 0.0]),
                     [0.0, 1.0],
                     LoadFrame::World,
-                    mbs_core::time_function::Constant(pr.mass_kg * 9.81),
+                    mbs_core::time_function::Constant(-pr.mass_kg * model.gravity()[1]),
                 )?;
                 system.add_element(weight)?;
             }

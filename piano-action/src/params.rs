@@ -446,6 +446,11 @@ pub struct NumericsParams {
     pub event_samples: usize,
 }
 
+/// Gravity (m/s², downward) for every model the crate builds: standard gravity 9.80665
+/// m/s² [V] (CGPM 1901) rounded to 9.81 as the project's results have always used [D]. The
+/// one place it is written; code that holds a model reads `Model::gravity` instead.
+pub const GRAVITY_M_S2: f64 = 9.81;
+
 /// The whole parameter set.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -81,7 +81,7 @@ pub fn swing_sampled(
     let mass = h.mass_g * 1e-3;
     let hanging = hanging_shank_angle_rad(params);
     let mut b = ModelBuilder::new();
-    b.gravity([0.0, -9.81]).add_link(
+    b.gravity([0.0, -crate::params::GRAVITY_M_S2]).add_link(
         "hammer",
         None,
         JointKind::Revolute,

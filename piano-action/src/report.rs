@@ -461,7 +461,7 @@ fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> R
             q.to_degrees(),
             w * strike_radius_m,
             0.5 * inertia_pin * w * w * 1e3,
-            mass * 9.81 * com * (q0.cos() - q.cos()) * 1e3,
+            mass * crate::params::GRAVITY_M_S2 * com * (q0.cos() - q.cos()) * 1e3,
         ];
         for (s, v) in series.iter_mut().zip(values) {
             s.2.push(r(v, 4));

@@ -891,7 +891,8 @@ pub fn write_pendulum_dir(
     let m = params.hammer.mass_g * 1e-3;
     let small = 2.0
         * std::f64::consts::PI
-        * (swing.inertia_pin_kg_m2 / (m * 9.81 * swing.com_distance_m)).sqrt();
+        * (swing.inertia_pin_kg_m2 / (m * crate::params::GRAVITY_M_S2 * swing.com_distance_m))
+            .sqrt();
     let summary = serde_json::json!({
         "model": "pendulum",
         "strikes": [],

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use piano_action::ActionParams;
 use piano_action::pendulum::swing;
 
-const G: f64 = 9.81;
+const G: f64 = piano_action::params::GRAVITY_M_S2;
 
 /// Arithmetic–geometric mean (exact large-amplitude pendulum period: T = T0 / AGM(1, cos θ/2)).
 fn agm(mut a: f64, mut b: f64) -> f64 {

@@ -22,8 +22,7 @@ use mbs_identify::Camera;
 use super::effects::FlangeEffects;
 use crate::params::ActionParams;
 
-/// Standard gravity (m/s²) [V] (the value `crate::pendulum` uses).
-pub const GRAVITY_M_S2: f64 = 9.81;
+pub use crate::params::GRAVITY_M_S2;
 
 /// The hammer on its pin, with its flange laws.
 #[derive(Clone, Copy, Debug, PartialEq)]
