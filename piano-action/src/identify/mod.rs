@@ -4,6 +4,7 @@
 //! in `mbs-identify`).
 
 pub mod commands;
+mod data_check;
 pub mod diagnose;
 pub mod effects;
 pub mod report;
