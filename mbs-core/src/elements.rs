@@ -275,6 +275,116 @@ impl ForceElement for PointSpringDamper {
     }
 }
 
+/// A cord (a tape, a string, a wire loop) between two body points: it pulls with tension
+/// `T = k (l − length) + c l̇` when stretched beyond its slack `length` and never pushes
+/// (`T ≥ 0`; slack, it exerts nothing). An upright action's bridle tape is one. Its switching
+/// function is `l − length`, so an integrator can locate the moment it goes taut or slack.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cord {
+    name: String,
+    a: ResolvedPoint,
+    b: ResolvedPoint,
+    stiffness: f64,
+    damping: f64,
+    length: f64,
+}
+
+impl Cord {
+    /// A cord from `a` to `b` of slack length `length` (> 0), stiffness and damping
+    /// non-negative. At least one end must be on a moving body.
+    pub fn new(
+        model: &Model,
+        name: &str,
+        a: Attachment<'_>,
+        b: Attachment<'_>,
+        length: f64,
+        stiffness: f64,
+        damping: f64,
+    ) -> Result<Self> {
+        let item = format!("cord '{name}'");
+        let a = a.resolve(model, &format!("{item}.a"))?;
+        let b = b.resolve(model, &format!("{item}.b"))?;
+        if a.body == BodyId::GROUND && b.body == BodyId::GROUND {
+            return Err(CoreError::InvalidParameter {
+                item,
+                message: "both ends are fixed to the ground, so it would act on nothing".into(),
+            });
+        }
+        let length = param(&item, "length", length, true)?;
+        if length <= 0.0 {
+            return Err(CoreError::InvalidParameter {
+                item: format!("{item}.length"),
+                message: format!("must be positive (the cord's slack length), got {length}"),
+            });
+        }
+        Ok(Self {
+            a,
+            b,
+            stiffness: param(&item, "stiffness", stiffness, true)?,
+            damping: param(&item, "damping", damping, true)?,
+            length,
+            name: item,
+        })
+    }
+
+    /// The distance (m) between the ends, from the poses in `ctx`.
+    pub fn span(&self, ctx: &ForceContext<'_>) -> f64 {
+        let pa = ctx.point_position(self.a.body, self.a.point);
+        let pb = ctx.point_position(self.b.body, self.b.point);
+        (pb[0] - pa[0]).hypot(pb[1] - pa[1])
+    }
+
+    /// The tension (N, ≥ 0) at span `l` and rate `l_dot`.
+    pub fn tension(&self, l: f64, l_dot: f64) -> f64 {
+        if l <= self.length {
+            return 0.0;
+        }
+        (self.stiffness * (l - self.length) + self.damping * l_dot).max(0.0)
+    }
+}
+
+impl ForceElement for Cord {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn check_model(&self, model: &Model) -> Result<()> {
+        self.a.check(model, &self.name)?;
+        self.b.check(model, &self.name)
+    }
+
+    fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
+        let (a, b) = (&self.a, &self.b);
+        let pa = ctx.point_position(a.body, a.point);
+        let pb = ctx.point_position(b.body, b.point);
+        let d = [pb[0] - pa[0], pb[1] - pa[1]];
+        let l = d[0].hypot(d[1]);
+        if l.is_nan() || l <= self.length {
+            return;
+        }
+        let u = [d[0] / l, d[1] / l];
+        let va = ctx.point_velocity(a.body, a.point);
+        let vb = ctx.point_velocity(b.body, b.point);
+        let ldot = (vb[0] - va[0]) * u[0] + (vb[1] - va[1]) * u[1];
+        let t = self.tension(l, ldot);
+        loads.add_force_at_point(a.body, pa, [t * u[0], t * u[1]]);
+        loads.add_force_at_point(b.body, pb, [-t * u[0], -t * u[1]]);
+    }
+
+    fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
+        let e = (self.span(ctx) - self.length).max(0.0);
+        0.5 * self.stiffness * e * e
+    }
+
+    fn switch_count(&self) -> usize {
+        1
+    }
+
+    fn switching_functions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
+        out[0] = self.span(ctx) - self.length;
+    }
+}
+
 /// The optional Stribeck part of pivot friction: the breakaway torque `static_torque` decays
 /// to the Coulomb level over the speed scale `velocity` as `exp(−(v / velocity)²)`.
 #[derive(Clone, Copy, Debug, PartialEq)]

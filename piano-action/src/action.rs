@@ -23,11 +23,9 @@
 
 use std::collections::BTreeMap;
 
-use mbs_contact::laws::{Hertz, HystereticFelt, RegularizedCoulomb};
-use mbs_contact::{Contact, ContactOutput, ContactSide, Shape, StringContact};
+use mbs_contact::{Contact, ContactOutput, Shape, StringContact};
 use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
-use mbs_core::elements::{FrictionLaw, JointLimit, JointSpringDamper, PivotFriction, SpringLaw};
-use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System, TimeFunction};
+use mbs_core::{System, TimeFunction};
 use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_observed};
 
 use crate::error::Result;
@@ -67,44 +65,13 @@ pub struct Action {
     /// The multibody system (model, force elements).
     pub system: System,
     /// Element index of each contact, by name (`"capstan_heel"`, `"hammer_string"`, ...).
-    pub contacts: BTreeMap<&'static str, usize>,
+    pub contacts: BTreeMap<String, usize>,
     /// The presser over the key front (a weight or a finger), if it was built with one.
     pub presser: Option<Presser>,
 }
 
 /// Radius of a [`Presser`]'s round pad (mm): its contact with the key top.
 pub const PRESSER_PAD_RADIUS_MM: f64 = 5.0;
-
-/// mm → m.
-fn m(v: [f64; 2]) -> [f64; 2] {
-    [v[0] * 1e-3, v[1] * 1e-3]
-}
-
-fn rel(p: [f64; 2], origin: [f64; 2]) -> [f64; 2] {
-    m([p[0] - origin[0], p[1] - origin[1]])
-}
-
-/// A horizontal ground face at height `y` over `x`, facing up or down (mm in, shape in m).
-fn ground_face(y: f64, x: [f64; 2], up: bool) -> Result<Shape> {
-    let (a, b) = if up {
-        ([x[0], y], [x[1], y])
-    } else {
-        ([x[1], y], [x[0], y])
-    };
-    Ok(Shape::segment(m(a), m(b))?)
-}
-
-/// A face through `p` along direction `d` (unit), from `back` before to `ahead` after `p`,
-/// its outward normal `d` turned a quarter counter-clockwise (mm in, shape in m).
-fn face(p: [f64; 2], d: [f64; 2], back: f64, ahead: f64) -> Result<Shape> {
-    let a = [p[0] - back * d[0], p[1] - back * d[1]];
-    let b = [p[0] + ahead * d[0], p[1] + ahead * d[1]];
-    Ok(Shape::segment(m(a), m(b))?)
-}
-
-fn circle(c: [f64; 2], r_mm: f64) -> Result<Shape> {
-    Ok(Shape::circle(m(c), r_mm * 1e-3)?)
-}
 
 /// A body over the key front sliding vertically above the finger point and touching the
 /// key top through a pad: a weight resting on or dropped onto the key (the 1 kg
@@ -168,410 +135,26 @@ impl Action {
                 ),
             ));
         }
-        let p = params;
-        let (k, w, j, r, h) = (&p.key, &p.wippen, &p.jack, &p.repetition_lever, &p.hammer);
-        let with_jack = kind != ModelKind::Simplified;
-        let with_lever = kind == ModelKind::Double;
+        let mechanism = crate::describe::grand_mechanism(params, kind, presser)?;
+        Self::from_mechanism(params, kind, presser, &mechanism)
+    }
 
-        // Bodies: mass (kg), centre of mass in the joint frame (m), inertia about it.
-        let mut b = ModelBuilder::new();
-        b.gravity([0.0, -crate::params::GRAVITY_M_S2]);
-        let key_com = rel(k.com_mm, k.pivot_mm);
-        let key_mass = k.mass_g * 1e-3;
-        let key_i = k.inertia_pivot_kg_m2 - key_mass * (key_com[0].powi(2) + key_com[1].powi(2));
-        b.add_link(
-            "key",
-            None,
-            JointKind::Revolute,
-            Placement::offset(k.pivot_mm[0] * 1e-3, k.pivot_mm[1] * 1e-3),
-            BodySpec::new(key_mass, key_com, key_i),
-        );
-        b.add_link(
-            "wippen",
-            None,
-            JointKind::Revolute,
-            Placement::offset(w.pivot_mm[0] * 1e-3, w.pivot_mm[1] * 1e-3),
-            BodySpec::new(
-                w.mass_g * 1e-3,
-                rel(w.com_mm, w.pivot_mm),
-                w.inertia_com_kg_m2,
-            ),
-        );
-        let jack_at = rel(j.pivot_mm, w.pivot_mm);
-        let jack_com = rel(j.com_mm, j.pivot_mm);
-        let jack_mass = j.mass_g * 1e-3;
-        let jack_i =
-            j.inertia_pivot_kg_m2 - jack_mass * (jack_com[0].powi(2) + jack_com[1].powi(2));
-        b.add_link(
-            "jack",
-            Some("wippen"),
-            if with_jack {
-                JointKind::Revolute
-            } else {
-                JointKind::Fixed
-            },
-            Placement::offset(jack_at[0], jack_at[1]),
-            BodySpec::new(jack_mass, jack_com, jack_i),
-        );
-        if with_lever {
-            let at = rel(r.pivot_mm, w.pivot_mm);
-            let com = rel(r.com_mm, r.pivot_mm);
-            let mass = r.mass_g * 1e-3;
-            let i = r.inertia_pivot_kg_m2 - mass * (com[0].powi(2) + com[1].powi(2));
-            b.add_link(
-                "repetition_lever",
-                Some("wippen"),
-                JointKind::Revolute,
-                Placement::offset(at[0], at[1]),
-                BodySpec::new(mass, com, i),
-            );
-        }
-        b.add_link(
-            "hammer",
-            None,
-            JointKind::Revolute,
-            Placement::new(
-                h.rest_angle_deg.to_radians(),
-                h.pivot_mm[0] * 1e-3,
-                h.pivot_mm[1] * 1e-3,
-            ),
-            BodySpec::new(h.mass_g * 1e-3, m(h.com_body_mm), h.inertia_com_kg_m2),
-        );
-        if let Some(pr) = presser {
-            b.add_link(
-                "presser",
-                None,
-                JointKind::Prismatic { axis: [0.0, 1.0] },
-                Placement::offset(
-                    k.finger_mm[0] * 1e-3,
-                    (k.finger_mm[1] + PRESSER_PAD_RADIUS_MM + pr.height_mm) * 1e-3,
-                ),
-                BodySpec::new(pr.mass_kg, [0.0, 0.0], pr.mass_kg * 1e-4),
-            );
-        }
-        let model = b.build()?;
-        let mut system = System::new(model.clone());
-
-        // Springs, stops and pivot friction.
-        let reg = p.numerics.pivot_friction_regularization_rad_s;
-        let mut pivots = vec![
-            ("key", k.pivot_friction_n_m),
-            ("wippen", w.pivot_friction_n_m),
-            ("hammer", h.pivot_friction_n_m),
-        ];
-        let (stop_k, stop_c) = (
-            p.numerics.stop_stiffness_n_m_per_rad,
-            p.numerics.stop_damping_n_m_s_per_rad,
-        );
-        if with_jack {
-            pivots.push(("jack", j.pivot_friction_n_m));
-            let law = SpringLaw::new(j.spring_stiffness_n_m_per_rad, 0.0)
-                .with_preload(-j.spring_preload_n_m);
-            system
-                .add_element(JointSpringDamper::new(&model, "jack", law)?.named("jack spring"))?;
-            system.add_element(JointLimit::new(
-                &model,
-                "jack",
-                j.stop_angle_rad,
-                j.outer_stop_rad,
-                stop_k,
-                stop_c,
-            )?)?;
-        }
-        if with_lever {
-            pivots.push(("repetition_lever", r.pivot_friction_n_m));
-            let law = SpringLaw::new(r.spring_stiffness_n_m_per_rad, 0.0)
-                .with_preload(-r.spring_preload_n_m);
-            system.add_element(
-                JointSpringDamper::new(&model, "repetition_lever", law)?.named("repetition spring"),
-            )?;
-            system.add_element(JointLimit::new(
-                &model,
-                "repetition_lever",
-                r.upper_stop_rad,
-                f64::INFINITY,
-                stop_k,
-                stop_c,
-            )?)?;
-        }
-        if !p.effects.is_empty() {
-            let laws = crate::identify::effects::FlangeEffects::from_entries(&p.effects)?;
-            system.add_element(crate::identify::effects::FlangeEffectElement::new(
-                &model,
-                "hammer",
-                laws,
-                reg,
-                h.mass_g * 1e-3,
-                m(h.com_body_mm),
-                h.rest_angle_deg.to_radians(),
-            )?)?;
-        }
-        for (joint, torque) in pivots {
-            if torque > 0.0 {
-                system.add_element(PivotFriction::new(
-                    &model,
-                    joint,
-                    FrictionLaw::coulomb(torque, reg),
-                )?)?;
-            }
-        }
-
-        // Contact shapes, each in its body's joint frame.
-        let g = &p.regulation;
-        let kp = k.pivot_mm;
-        let capstan = [
-            k.capstan_center_mm[0],
-            k.capstan_center_mm[1] + g.capstan_raise_mm,
-        ];
-        let heel = face(
-            [w.heel_mm[0] - w.pivot_mm[0], w.heel_mm[1] - w.pivot_mm[1]],
-            [-1.0, 0.0],
-            w.heel_half_length_mm,
-            w.heel_half_length_mm,
-        )?;
-        // Jack top: along t, facing the jack axis n.
-        let n = j.axis;
-        let t = [n[1], -n[0]];
-        let jack_top = face(
-            [j.top_mm[0] - j.pivot_mm[0], j.top_mm[1] - j.pivot_mm[1]],
-            t,
-            j.top_front_edge_mm,
-            j.top_back_edge_mm,
-        )?;
-        let toe = circle(
-            [
-                j.toe_mm[0] - j.pivot_mm[0],
-                j.toe_mm[1] - j.pivot_mm[1] - j.toe_radius_mm,
-            ],
-            j.toe_radius_mm,
-        )?;
-        // Backcheck face on the key, at its angle, facing the hammer tail at rest.
-        let a = k.backcheck_face_angle_deg.to_radians();
-        let d = [a.cos(), a.sin()];
-        let tail_rest = {
-            let (s, c) = h.rest_angle_deg.to_radians().sin_cos();
-            let tb = h.tail_body_mm;
-            [
-                h.pivot_mm[0] + c * tb[0] - s * tb[1],
-                h.pivot_mm[1] + s * tb[0] + c * tb[1],
-            ]
-        };
-        let to_tail = [
-            tail_rest[0] - k.backcheck_mm[0],
-            tail_rest[1] - k.backcheck_mm[1],
-        ];
-        let d = if -d[1] * to_tail[0] + d[0] * to_tail[1] >= 0.0 {
-            d
-        } else {
-            [-d[0], -d[1]]
-        };
-        // Outward normal of the face (toward the tail); the regulation offset moves it.
-        let off = g.backcheck_offset_mm;
-        let backcheck = face(
-            [
-                k.backcheck_mm[0] - kp[0] - off * d[1],
-                k.backcheck_mm[1] - kp[1] + off * d[0],
-            ],
-            d,
-            k.backcheck_half_length_mm,
-            k.backcheck_half_length_mm,
-        )?;
-        let knuckle = circle(h.knuckle_body_mm, h.knuckle_radius_mm)?;
-        let crown = circle(
-            [h.strike_body_mm[0], h.strike_body_mm[1] - h.crown_radius_mm],
-            h.crown_radius_mm,
-        )?;
-        let tail = circle(h.tail_body_mm, h.tail_radius_mm)?;
-        let shank_under = circle([h.rest_body_mm[0], h.rest_body_mm[1] + 0.5], 0.5)?;
-
-        let mut contacts = BTreeMap::new();
-        let mut add = |name: &'static str,
-                       a: ContactSide,
-                       b: ContactSide,
-                       law: &ContactParams,
-                       system: &mut System|
-         -> Result<()> {
-            // Felt, cloth and leather lose the same share of energy in a slow settle as in a
-            // hard blow (rate-independent hysteresis, Boutillon 1988; Hirschkorn et al.
-            // 2006): restitution `e` at every speed above the smoothing speed.
-            let normal = HystereticFelt::from_restitution(
-                law.k,
-                law.p,
-                law.e,
-                p.numerics.felt_smoothing_m_s,
-            )?;
-            let mut c = Contact::new(&model, name, a, b, normal)?;
-            if law.mu > 0.0 {
-                c = c.with_friction(RegularizedCoulomb::new(
-                    law.mu,
-                    p.numerics.friction_regularization_m_s,
-                )?);
-            }
-            contacts.insert(name, system.add_element(c)?);
-            Ok(())
-        };
-        let c = &p.contacts;
-        add(
-            "front_rail",
-            ContactSide::ground(vec![ground_face(
-                g.front_rail_top_y_mm,
-                g.front_rail_x_mm,
-                true,
-            )?]),
-            ContactSide::on(
-                "key",
-                vec![circle(
-                    [k.front_pad_mm[0] - kp[0], k.front_pad_mm[1] - kp[1]],
-                    k.front_pad_radius_mm,
-                )?],
-            ),
-            &c.front_rail,
-            &mut system,
-        )?;
-        add(
-            "back_rail",
-            ContactSide::ground(vec![ground_face(
-                g.back_rail_top_y_mm,
-                g.back_rail_x_mm,
-                true,
-            )?]),
-            ContactSide::on(
-                "key",
-                vec![circle(
-                    [k.back_pad_mm[0] - kp[0], k.back_pad_mm[1] - kp[1]],
-                    k.back_pad_radius_mm,
-                )?],
-            ),
-            &c.back_rail,
-            &mut system,
-        )?;
-        add(
-            "capstan_heel",
-            ContactSide::on(
-                "key",
-                vec![circle(
-                    [capstan[0] - kp[0], capstan[1] - kp[1]],
-                    k.capstan_radius_mm,
-                )?],
-            ),
-            ContactSide::on("wippen", vec![heel]),
-            &c.capstan_heel,
-            &mut system,
-        )?;
-        add(
-            "jack_knuckle",
-            ContactSide::on("jack", vec![jack_top]),
-            ContactSide::on("hammer", vec![knuckle]),
-            &c.jack_knuckle,
-            &mut system,
-        )?;
-        if with_jack {
-            add(
-                "let_off_button",
-                ContactSide::ground(vec![ground_face(
-                    g.let_off_button_y_mm,
-                    g.let_off_button_x_mm,
-                    false,
-                )?]),
-                ContactSide::on("jack", vec![toe]),
-                &c.let_off_button,
-                &mut system,
-            )?;
-            add(
-                "backcheck",
-                ContactSide::on("key", vec![backcheck]),
-                ContactSide::on("hammer", vec![tail]),
-                &c.backcheck,
-                &mut system,
-            )?;
-        }
-        if with_lever {
-            let lever_top = face(
-                [r.top_mm[0] - r.pivot_mm[0], r.top_mm[1] - r.pivot_mm[1]],
-                t,
-                r.top_front_edge_mm,
-                r.top_back_edge_mm,
-            )?;
-            let tip = circle(
-                [
-                    r.tip_mm[0] - r.pivot_mm[0],
-                    r.tip_mm[1] - r.pivot_mm[1] - r.tip_radius_mm,
-                ],
-                r.tip_radius_mm,
-            )?;
-            add(
-                "lever_knuckle",
-                ContactSide::on("repetition_lever", vec![lever_top]),
-                ContactSide::on("hammer", vec![knuckle]),
-                &c.lever_knuckle,
-                &mut system,
-            )?;
-            add(
-                "drop_screw",
-                ContactSide::ground(vec![ground_face(
-                    g.drop_screw_y_mm,
-                    g.drop_screw_x_mm,
-                    false,
-                )?]),
-                ContactSide::on("repetition_lever", vec![tip]),
-                &c.drop_screw,
-                &mut system,
-            )?;
-        }
-        add(
-            "rest_rail",
-            ContactSide::ground(vec![ground_face(
-                g.rest_rail_top_y_mm,
-                g.rest_rail_x_mm,
-                true,
-            )?]),
-            ContactSide::on("hammer", vec![shank_under]),
-            &c.rest_rail,
-            &mut system,
-        )?;
-        if let Some(pr) = presser {
-            if pr.carried {
-                let weight = AppliedLoad::force(
-                    &model,
-                    "presser weight carried",
-                    Attachment::on("presser", [0.0, 0.0]),
-                    [0.0, 1.0],
-                    LoadFrame::World,
-                    mbs_core::time_function::Constant(-pr.mass_kg * model.gravity()[1]),
-                )?;
-                system.add_element(weight)?;
-            }
-            let kf = [k.finger_mm[0] - kp[0], k.finger_mm[1] - kp[1]];
-            add(
-                "presser_key",
-                ContactSide::on(
-                    "key",
-                    vec![Shape::segment(
-                        m([kf[0] - 12.0, kf[1]]),
-                        m([kf[0] + 12.0, kf[1]]),
-                    )?],
-                ),
-                ContactSide::on("presser", vec![circle([0.0, 0.0], PRESSER_PAD_RADIUS_MM)?]),
-                &pr.pad,
-                &mut system,
-            )?;
-        }
-        // The hammer strikes a modal string lying along the string line (the felt undamped:
-        // the string's motion gives the rebound). Added last: its states end the state.
-        let string = StringContact::new(
-            &model,
-            "hammer_string",
-            p.string.build()?,
-            ground_face(g.string_y_mm, g.string_x_mm, false)?,
-            ContactSide::on("hammer", vec![crown]),
-            Hertz::new(c.hammer_string.k, c.hammer_string.p)?,
-        )?;
-        contacts.insert("hammer_string", system.add_element(string)?);
+    /// Assembles the action from `mechanism`, a description of the grand `kind` (as
+    /// [`crate::describe::grand_mechanism`] writes it, possibly transformed or read back
+    /// from a file); `params` are those it was written from (regulation, touchweight and
+    /// the drawings read them).
+    pub fn from_mechanism(
+        params: &ActionParams,
+        kind: ModelKind,
+        presser: Option<Presser>,
+        mechanism: &mbs_mechanism::Mechanism,
+    ) -> Result<Action> {
+        let built = mechanism.build_with(&crate::describe::PianoExtensions)?;
         Ok(Action {
             kind,
             params: params.clone(),
-            system,
-            contacts,
+            system: built.system,
+            contacts: built.contacts,
             presser,
         })
     }

@@ -1079,10 +1079,10 @@ fn draw_shape(svg: &mut Svg, s: &Shape) {
 
 /// What the drawing needs of one contact at `(t, x)`: its shapes in the world (m), whether
 /// it is pressed and where.
-struct ContactView {
-    name: &'static str,
+struct ContactView<'a> {
+    name: &'a str,
     /// The name in the legend: the presser's pad is the finger's or the mass's.
-    label: &'static str,
+    label: &'a str,
     shapes: Vec<Shape>,
     active: bool,
     point: Option<P>,
@@ -1126,7 +1126,8 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
 
     // Contacts: shapes in the world, pressed or not, where.
     let mut contacts = Vec::new();
-    for (&name, &e) in &action.contacts {
+    for (name, &e) in &action.contacts {
+        let name = name.as_str();
         let gap = action.gap(name, t, x)?;
         let ctx = system.element_context(&mut ws, t, x, e)?;
         let contact = system.elements().nth(e).and_then(ContactElement::of);
@@ -1512,7 +1513,8 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
     let mut contacts = Vec::new();
     let mut rest_data = Data::new(model);
     update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
-    for (&name, &e) in &action.contacts {
+    for (name, &e) in &action.contacts {
+        let name = name.as_str();
         let Some(c) = action.system.elements().nth(e).and_then(ContactElement::of) else {
             continue;
         };

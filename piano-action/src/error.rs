@@ -108,6 +108,9 @@ pub enum PianoError {
     /// A contact could not be built.
     #[error(transparent)]
     Contact(#[from] mbs_contact::ContactError),
+    /// A mechanism description is wrong (the message names its file, line and field).
+    #[error("mechanism description {0}")]
+    Mechanism(#[from] mbs_mechanism::MechanismError),
     /// No parameter has this path (`piano params --list` prints them all).
     #[error(
         "no parameter '{path}'{}; `piano params --list` prints every path",

@@ -20,6 +20,7 @@
 #![warn(missing_docs)]
 
 mod action;
+pub mod describe;
 pub mod drawing;
 mod error;
 #[doc(hidden)]
@@ -48,3 +49,7 @@ pub use params::ActionParams;
 pub use simulate::{
     BLOW_PULSE_GAP_S, Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate,
 };
+
+/// Mechanism descriptions (re-exported from `mbs-mechanism`): what an example or another
+/// striking mechanism builds through this crate's public API.
+pub use mbs_mechanism as mechanism;

@@ -48,6 +48,24 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Write the mechanism description of a grand model (TOML, or JSON with --json) to
+    /// stdout or --out: bodies, joints, springs, contacts, the string, inputs and markers
+    /// in SI units, built from the parameter file. `piano simulate` runs a scenario with
+    /// `mechanism = "FILE"` from it, exactly as the built-in model.
+    Describe {
+        /// `simplified`, `single` or `double`.
+        #[arg(long, default_value = "double")]
+        model: String,
+        /// JSON instead of TOML.
+        #[arg(long)]
+        json: bool,
+        /// Write to this file instead of stdout (an existing file is not overwritten).
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+        /// Replace an existing --out file.
+        #[arg(long)]
+        force: bool,
+    },
     /// Write the interactive report of one or more run directories: one self-contained
     /// HTML page replaying them in slow motion, to scale, with contact forces, events and
     /// linked plots.
@@ -568,6 +586,41 @@ fn model_kind(name: &str) -> Result<ModelKind, String> {
         })
 }
 
+fn describe(
+    params: &ActionParams,
+    model: &str,
+    json: bool,
+    out: Option<&std::path::Path>,
+    force: bool,
+) -> Result<(), String> {
+    let kind = model_kind(model)?;
+    let mechanism =
+        piano_action::describe::grand_mechanism(params, kind, None).map_err(|e| e.to_string())?;
+    let text = if json {
+        mechanism.to_json_string()
+    } else {
+        mechanism.to_toml_string()
+    }
+    .map_err(|e| e.to_string())?;
+    match out {
+        None => {
+            use std::io::Write;
+            let _ = std::io::stdout().write_all(text.as_bytes());
+        }
+        Some(path) => {
+            if path.exists() && !force {
+                return Err(format!(
+                    "{}: exists; pass --force to replace it",
+                    path.display()
+                ));
+            }
+            std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
 fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), String> {
     let kind = model_kind(model)?;
     let w = with_spinner("measuring the touchweight", || {
@@ -1008,6 +1061,12 @@ fn main() -> ExitCode {
         _ => load(cli.params.as_deref()).and_then(|params| match command {
             Command::Demo => demo(&params),
             Command::Touchweight { model, json } => touchweight(&params, &model, json),
+            Command::Describe {
+                model,
+                json,
+                out,
+                force,
+            } => describe(&params, &model, json, out.as_deref(), force),
             Command::Validate {
                 model,
                 json,

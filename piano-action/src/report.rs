@@ -253,7 +253,7 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         .as_array()
         .map(|a| a.iter().filter_map(Value::as_str).collect())
         .unwrap_or_default();
-    let contact_names: Vec<&'static str> = action.contacts.keys().copied().collect();
+    let contact_names: Vec<&str> = action.contacts.keys().map(String::as_str).collect();
 
     let n = rows.len();
     let mut t = Vec::with_capacity(n);

@@ -779,7 +779,7 @@ pub fn write_run_dir(
 fn write_contacts_and_drawings(dir: &Path, prepared: &Prepared, run: &Run) -> Result<()> {
     let action = &prepared.action;
     let sol = &run.solution;
-    let names: Vec<&str> = action.contacts.keys().copied().collect();
+    let names: Vec<&str> = action.contacts.keys().map(String::as_str).collect();
     let mut csv = String::from("time_s");
     for n in &names {
         let _ = write!(csv, ",{n}_gap_mm,{n}_force_n");

@@ -3,12 +3,12 @@
 
 use piano_action::{Action, ActionParams, ModelKind};
 
-fn gaps_mm(action: &Action) -> Vec<(&'static str, f64)> {
+fn gaps_mm(action: &Action) -> Vec<(&str, f64)> {
     let x = action.layout_state().unwrap();
     action
         .contacts
         .keys()
-        .map(|&name| (name, action.gap(name, 0.0, &x).unwrap() * 1e3))
+        .map(|name| (name.as_str(), action.gap(name, 0.0, &x).unwrap() * 1e3))
         .collect()
 }
 
