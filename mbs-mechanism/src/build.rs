@@ -66,6 +66,89 @@ pub struct Built {
     pub contacts: BTreeMap<String, usize>,
 }
 
+impl Built {
+    /// The input named `name` of `mechanism` (which this was built from).
+    fn input<'m>(mechanism: &'m Mechanism, name: &str, kind: InputKind) -> Result<&'m Input> {
+        let input = mechanism
+            .inputs
+            .iter()
+            .find(|i| i.name == name)
+            .ok_or_else(|| {
+                MechanismError::field(
+                    "inputs",
+                    format!(
+                        "no input '{name}' (inputs: {})",
+                        mechanism
+                            .inputs
+                            .iter()
+                            .map(|i| i.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                )
+            })?;
+        if input.kind != kind {
+            return Err(MechanismError::field(
+                "inputs",
+                format!(
+                    "input '{name}' is a {:?} input, not a {kind:?} input",
+                    input.kind
+                ),
+            ));
+        }
+        Ok(input)
+    }
+
+    /// Drives the force input `name` of `mechanism` (which this was built from): a force of
+    /// `magnitude(t)` newtons along the input's world direction at its point. Returns the
+    /// element's index.
+    pub fn drive_force(
+        &mut self,
+        mechanism: &Mechanism,
+        name: &str,
+        magnitude: impl mbs_core::TimeFunction + 'static,
+    ) -> Result<usize> {
+        let input = Self::input(mechanism, name, InputKind::Force)?;
+        let model = self.system.model().clone();
+        let field = format!("inputs.{name}");
+        let load = AppliedLoad::force(
+            &model,
+            name,
+            attachment(&input.at),
+            input.direction,
+            LoadFrame::World,
+            magnitude,
+        )
+        .map_err(core(&field))?;
+        let index = self.system.add_element(load).map_err(core(&field))?;
+        self.elements.insert(name.to_string(), index);
+        Ok(index)
+    }
+
+    /// Drives the motion input `name`: its body's coordinate follows `drive` (rad or m; use
+    /// the mechanism's geometry to turn a measured displacement into the coordinate).
+    pub fn drive_motion(
+        &mut self,
+        mechanism: &Mechanism,
+        name: &str,
+        drive: impl mbs_core::Drive + 'static,
+    ) -> Result<()> {
+        let input = Self::input(mechanism, name, InputKind::Motion)?;
+        self.system
+            .prescribe(&input.at.body, drive)
+            .map_err(core(&format!("inputs.{name}")))
+    }
+
+    /// The state of the layout at rest: every coordinate and velocity zero, internal
+    /// states (felt memory, string modes) at their initial values.
+    pub fn layout_state(&self) -> Result<Vec<f64>> {
+        let n = self.system.model().nv();
+        self.system
+            .initial_state(0.0, &vec![0.0; n], &vec![0.0; n])
+            .map_err(core(""))
+    }
+}
+
 impl std::fmt::Debug for Built {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Built")

@@ -8,8 +8,8 @@ use serde::de::DeserializeOwned;
 
 use crate::error::{InputKind, PianoError, Result};
 
-pub use mbs_mechanism::toml_lines::{line_at, line_of};
 pub(crate) use mbs_mechanism::toml_lines::{Step, steps};
+pub use mbs_mechanism::toml_lines::{line_at, line_of};
 
 /// Parses `text` as a `T` of `kind`: a syntax error gives its line and the parser's
 /// message; a value that does not fit gives the field path and its line.
