@@ -530,6 +530,19 @@ impl System {
         Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[states]))
     }
 
+    /// The kinematics at `(t, x)`: poses and velocities of every body, with prescribed
+    /// coordinates taken from their drives (the context of no element: its `states` are
+    /// empty). For outputs such as a marker's speed or a body's pose at a state.
+    pub fn kinematics<'a>(
+        &'a self,
+        ws: &'a mut Workspace,
+        t: f64,
+        x: &'a [f64],
+    ) -> Result<ForceContext<'a>> {
+        self.prepare(ws, t, x)?;
+        Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[..0]))
+    }
+
     /// The energy of state `x` at time `t`: kinetic, gravitational and stored in elements.
     pub fn energy(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<Energy> {
         self.prepare(ws, t, x)?;

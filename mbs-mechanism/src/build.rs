@@ -55,6 +55,52 @@ impl Extensions for NoExtensions {
     }
 }
 
+/// The switching function of a coordinate event: `q − value`, exerting no force.
+#[derive(Clone, Debug)]
+struct CoordinateWatch {
+    name: String,
+    coordinate: usize,
+    value: f64,
+    direction: mbs_core::Crossing,
+}
+
+impl ForceElement for CoordinateWatch {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn check_model(&self, model: &Model) -> mbs_core::Result<()> {
+        if self.coordinate < model.nv() {
+            Ok(())
+        } else {
+            Err(mbs_core::CoreError::UnknownName {
+                what: "coordinate index",
+                name: self.coordinate.to_string(),
+            })
+        }
+    }
+
+    fn apply(
+        &self,
+        _ctx: &mbs_core::ForceContext<'_>,
+        _loads: &mut mbs_core::Loads<'_>,
+        _rates: &mut [f64],
+    ) {
+    }
+
+    fn switch_count(&self) -> usize {
+        1
+    }
+
+    fn switching_functions(&self, ctx: &mbs_core::ForceContext<'_>, out: &mut [f64]) {
+        out[0] = ctx.q[self.coordinate] - self.value;
+    }
+
+    fn switch_direction(&self, _k: usize) -> mbs_core::Crossing {
+        self.direction
+    }
+}
+
 /// A built mechanism: the system and where its named parts are.
 pub struct Built {
     /// The system to integrate.
@@ -64,6 +110,8 @@ pub struct Built {
     pub elements: BTreeMap<String, usize>,
     /// Element index of each contact and string, by name.
     pub contacts: BTreeMap<String, usize>,
+    /// Element index of the switching function of each coordinate event, by event name.
+    pub watches: BTreeMap<String, usize>,
 }
 
 impl Built {
@@ -437,10 +485,29 @@ impl Mechanism {
             elements.insert(s.name.clone(), index);
             contacts.insert(s.name.clone(), index);
         }
+        // Coordinate events last: they exert nothing, and the integrator locates them.
+        let mut watches = BTreeMap::new();
+        for (i, e) in self.events.iter().enumerate() {
+            if let (Some(body), Some(value)) = (&e.coordinate, e.value) {
+                let f = format!("events[{i}]");
+                let watch = CoordinateWatch {
+                    name: format!("event '{}'", e.name),
+                    coordinate: model.coordinate_id(body).map_err(core(&f))?,
+                    value,
+                    direction: match e.direction.unwrap_or(CrossingSpec::Both) {
+                        CrossingSpec::Rising => mbs_core::Crossing::Rising,
+                        CrossingSpec::Falling => mbs_core::Crossing::Falling,
+                        CrossingSpec::Both => mbs_core::Crossing::Both,
+                    },
+                };
+                watches.insert(e.name.clone(), system.add_element(watch).map_err(core(&f))?);
+            }
+        }
         Ok(Built {
             system,
             elements,
             contacts,
+            watches,
         })
     }
 }

@@ -39,6 +39,7 @@
 mod build;
 pub mod description;
 mod error;
+mod evaluate;
 mod io;
 pub mod toml_lines;
 mod validate;
@@ -46,5 +47,6 @@ mod validate;
 pub use build::{Built, Extensions, NoExtensions, normal_law, shapes};
 pub use description::*;
 pub use error::{MechanismError, Result};
+pub use evaluate::{EventOccurrence, MetricValue};
 pub use io::Format;
 pub use validate::material_names;

@@ -1113,15 +1113,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         .into());
     }
     let system = &action.system;
-    let Some(&first) = action.contacts.values().next() else {
-        return Err(CoreError::UnknownName {
-            what: "contact",
-            name: "any (the action has none)".into(),
-        }
-        .into());
-    };
-
-    let (rest, carry) = rest_and_carry(action, t, x, first)?;
+    let (rest, carry) = rest_and_carry(action, t, x)?;
     let mut ws = system.workspace();
 
     // Contacts: shapes in the world, pressed or not, where.
@@ -1374,14 +1366,13 @@ fn drawn_frames(action: &Action) -> Vec<&'static str> {
 }
 
 /// Rest poses (q = 0, the layout) of every drawn frame, and the motion carrying each from
-/// its rest place to where it is at `(t, x)` (`X_now ∘ X_rest⁻¹`), computed through element
-/// `element`'s context (so a prescribed coordinate takes its drive's value).
+/// its rest place to where it is at `(t, x)` (`X_now ∘ X_rest⁻¹`; a prescribed coordinate
+/// takes its drive's value).
 #[allow(clippy::type_complexity)]
 fn rest_and_carry(
     action: &Action,
     t: f64,
     x: &[f64],
-    element: usize,
 ) -> Result<(
     BTreeMap<&'static str, Transform>,
     BTreeMap<&'static str, Transform>,
@@ -1393,7 +1384,7 @@ fn rest_and_carry(
     let mut ws = system.workspace();
     let mut carry = BTreeMap::new();
     let mut rest = BTreeMap::new();
-    let ctx = system.element_context(&mut ws, t, x, element)?;
+    let ctx = system.kinematics(&mut ws, t, x)?;
     for name in drawn_frames(action) {
         let id = model.frame_id(name)?;
         let x0 = frame_pose(model, &rest_data, id);
@@ -1495,17 +1486,7 @@ fn parts_json(parts: &[Part]) -> Vec<serde_json::Value> {
 pub fn scene(action: &Action) -> Result<serde_json::Value> {
     let (rest, _) = {
         let x = action.layout_state()?;
-        let first =
-            action
-                .contacts
-                .values()
-                .next()
-                .copied()
-                .ok_or_else(|| CoreError::UnknownName {
-                    what: "contact",
-                    name: "any (the action has none)".into(),
-                })?;
-        rest_and_carry(action, 0.0, &x, first)?
+        rest_and_carry(action, 0.0, &x)?
     };
     let parts = parts_json(&build_parts(action, &rest));
     // Contact shapes in their rest places (mm), by side.
@@ -1561,16 +1542,7 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
 /// For every drawn frame, the motion `[angle (rad), x (mm), y (mm)]` carrying its parts from
 /// their rest places to where they are at `(t, x)` (see [`scene`]).
 pub fn carry(action: &Action, t: f64, x: &[f64]) -> Result<Vec<(&'static str, [f64; 3])>> {
-    let first = action
-        .contacts
-        .values()
-        .next()
-        .copied()
-        .ok_or_else(|| CoreError::UnknownName {
-            what: "contact",
-            name: "any (the action has none)".into(),
-        })?;
-    let (_, carry) = rest_and_carry(action, t, x, first)?;
+    let (_, carry) = rest_and_carry(action, t, x)?;
     Ok(drawn_frames(action)
         .into_iter()
         .filter_map(|f| carry.get(f).map(|c| (f, [c.angle(), c.x * 1e3, c.y * 1e3])))
