@@ -203,26 +203,15 @@ impl Action {
         output_step: Option<f64>,
         progress: &mut dyn FnMut(f64),
     ) -> Result<Solution> {
-        let opts = Options {
-            max_step,
-            output_step,
-            event_samples: self.params.numerics.event_samples,
-            ..Options::with_tolerances(
-                self.params.numerics.relative_tolerance,
-                self.params.numerics.absolute_tolerance,
-            )
-        };
-        solve_observed(
-            &mut MultibodyOde::new(&self.system),
-            Method::TrBdf2,
-            0.0,
+        integrate_system(
+            &self.system,
+            &self.params.numerics,
             x0,
             t_end,
-            &opts,
-            &mut |_, _| EventAction::Record,
+            max_step,
+            output_step,
             progress,
         )
-        .map_err(|e| crate::PianoError::Simulation(e.to_string()))
     }
 
     /// The coordinates of `kind` settled at rest with nothing on the key: the layout state
@@ -352,6 +341,38 @@ impl Action {
         }
         Ok(g[0])
     }
+}
+
+/// Integrates `system` from `x0` to `t_end` with TR-BDF2 and the tolerances and event
+/// sampling of `numerics`, steps of at most `max_step`, output every `output_step` (or
+/// every step), recording every event and calling `progress` with the simulated time after
+/// every step.
+pub fn integrate_system(
+    system: &System,
+    numerics: &crate::params::NumericsParams,
+    x0: &[f64],
+    t_end: f64,
+    max_step: f64,
+    output_step: Option<f64>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Solution> {
+    let opts = Options {
+        max_step,
+        output_step,
+        event_samples: numerics.event_samples,
+        ..Options::with_tolerances(numerics.relative_tolerance, numerics.absolute_tolerance)
+    };
+    solve_observed(
+        &mut MultibodyOde::new(system),
+        Method::TrBdf2,
+        0.0,
+        x0,
+        t_end,
+        &opts,
+        &mut |_, _| EventAction::Record,
+        progress,
+    )
+    .map_err(|e| crate::PianoError::Simulation(e.to_string()))
 }
 
 /// A contact element of the action: a plain [`Contact`] or the hammer on the string

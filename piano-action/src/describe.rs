@@ -29,9 +29,10 @@ use std::collections::BTreeMap;
 
 use mbs_core::{ForceElement, Model};
 use mbs_mechanism::{
-    Body, BodyPoint, ContactFrictionSpec, ContactPair, ContactSideSpec, Extension, Extensions,
-    Input, InputKind, Joint, JointType, LawSpec, Limits, LoadSpec, Marker, Mechanism,
-    MechanismError, PivotFrictionSpec, ShapeSpec, StringModes, StringPair, TorsionSpring,
+    Body, BodyPoint, ContactFrictionSpec, ContactPair, ContactPhase, ContactSideSpec, EventSpec,
+    Extension, Extensions, Input, InputKind, Joint, JointType, LawSpec, Limits, LoadSpec, Marker,
+    Mechanism, MechanismError, Metric, PivotFrictionSpec, Quantity, ShapeSpec, StringModes,
+    StringPair, TorsionSpring,
 };
 
 use crate::action::{ModelKind, PRESSER_PAD_RADIUS_MM, Presser};
@@ -611,6 +612,68 @@ pub fn grand_mechanism(
         events: Vec::new(),
         metrics: Vec::new(),
     })
+}
+
+/// The grand action `kind` as `piano describe` writes it: [`grand_mechanism`] with the
+/// drawing's outlines (so any tool draws it like the built-in model), the grand's named
+/// events (`key_bottom`, `let_off`, `strike`, `string_release`, `check`) and metrics (the
+/// crown's speed and the time at the first strike, the let-off time).
+pub fn grand_description(params: &ActionParams, kind: ModelKind) -> Result<Mechanism> {
+    let mut m = grand_mechanism(params, kind, None)?;
+    let action = crate::Action::from_mechanism(params, kind, None, &m)?;
+    let (ground, mut outlines) = crate::drawing::grand_outlines(&action)?;
+    m.ground = ground;
+    for body in &mut m.bodies {
+        body.outline = outlines.remove(&body.name).unwrap_or_default();
+    }
+    let contact = |name: &str, contact: &str, on: ContactPhase| EventSpec {
+        name: name.into(),
+        contact: Some(contact.into()),
+        on: Some(on),
+        coordinate: None,
+        value: None,
+        direction: None,
+    };
+    m.events
+        .push(contact("key_bottom", "front_rail", ContactPhase::Onset));
+    if kind != ModelKind::Simplified {
+        m.events
+            .push(contact("let_off", "let_off_button", ContactPhase::Onset));
+    }
+    m.events
+        .push(contact("strike", "hammer_string", ContactPhase::Onset));
+    m.events.push(contact(
+        "string_release",
+        "hammer_string",
+        ContactPhase::Release,
+    ));
+    if kind != ModelKind::Simplified {
+        m.events
+            .push(contact("check", "backcheck", ContactPhase::Onset));
+    }
+    let metric =
+        |name: &str, quantity: Quantity, marker: Option<&str>, at: &str, unit: &str| Metric {
+            name: name.into(),
+            quantity,
+            marker: marker.map(str::to_string),
+            at: at.into(),
+            unit: unit.into(),
+        };
+    m.metrics.push(metric(
+        "hammer speed at the strike",
+        Quantity::Speed,
+        Some("hammer_crown"),
+        "strike",
+        "m/s",
+    ));
+    m.metrics
+        .push(metric("strike time", Quantity::Time, None, "strike", "s"));
+    if kind != ModelKind::Simplified {
+        m.metrics
+            .push(metric("let-off time", Quantity::Time, None, "let_off", "s"));
+    }
+    m.validate()?;
+    Ok(m)
 }
 
 fn finite_or_none(v: f64) -> Option<f64> {

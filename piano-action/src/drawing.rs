@@ -23,6 +23,7 @@ use std::fmt::Write;
 
 use mbs_contact::Shape;
 use mbs_core::{CoreError, Data, Transform, frame_pose, update_poses};
+use mbs_mechanism::{Built, Mechanism, OutlinePart};
 
 use crate::action::{Action, ContactElement, PRESSER_PAD_RADIUS_MM, Presser};
 use crate::error::Result;
@@ -142,9 +143,9 @@ struct Label {
 /// (`None`: fixed to the ground).
 #[derive(Clone, Debug)]
 struct Part {
-    id: &'static str,
-    frame: Option<&'static str>,
-    pieces: Vec<(Outline, &'static str)>,
+    id: String,
+    frame: Option<String>,
+    pieces: Vec<(Outline, String)>,
     pivots: Vec<P>,
     labels: Vec<Label>,
     /// Seen through the action: a part in another plane (the action bracket stands between
@@ -153,10 +154,10 @@ struct Part {
 }
 
 impl Part {
-    fn new(id: &'static str, frame: Option<&'static str>) -> Self {
+    fn new(id: &str, frame: Option<&str>) -> Self {
         Self {
-            id,
-            frame,
+            id: id.to_string(),
+            frame: frame.map(str::to_string),
             pieces: Vec::new(),
             pivots: Vec::new(),
             labels: Vec::new(),
@@ -175,16 +176,17 @@ impl Part {
         });
     }
 
-    fn polygon(&mut self, pts: Vec<P>, fill: &'static str) {
-        self.pieces.push((Outline::Polygon(pts), fill));
+    fn polygon(&mut self, pts: Vec<P>, fill: &str) {
+        self.pieces.push((Outline::Polygon(pts), fill.to_string()));
     }
 
-    fn circle(&mut self, c: P, r: f64, fill: &'static str) {
-        self.pieces.push((Outline::Circle(c, r), fill));
+    fn circle(&mut self, c: P, r: f64, fill: &str) {
+        self.pieces.push((Outline::Circle(c, r), fill.to_string()));
     }
 
-    fn wire(&mut self, pts: Vec<P>, width: f64, fill: &'static str) {
-        self.pieces.push((Outline::Wire(pts, width), fill));
+    fn wire(&mut self, pts: Vec<P>, width: f64, fill: &str) {
+        self.pieces
+            .push((Outline::Wire(pts, width), fill.to_string()));
     }
 }
 
@@ -1112,18 +1114,45 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         }
         .into());
     }
-    let system = &action.system;
     let (rest, carry) = rest_and_carry(action, t, x)?;
-    let mut ws = system.workspace();
+    let contacts = contact_views(&action.system, &action.contacts, t, x, |name| {
+        match (name, action.presser) {
+            ("presser_key", Some(p)) if p.carried => "finger_key",
+            ("presser_key", Some(_)) => "mass_key",
+            _ => name,
+        }
+    })?;
 
-    // Contacts: shapes in the world, pressed or not, where.
-    let mut contacts = Vec::new();
-    for (name, &e) in &action.contacts {
+    let parts = build_parts(action, &rest);
+    let legend = format!(
+        "contact shapes of the {} model; white dots: pivots",
+        action.kind.name()
+    );
+    Ok(render(&parts, &carry, &contacts, &legend, title))
+}
+
+/// What the drawings need of every contact of `system` (`contacts`: element index by name)
+/// at `(t, x)`, named in the legend by `label`.
+fn contact_views<'a>(
+    system: &mbs_core::System,
+    contacts: &'a BTreeMap<String, usize>,
+    t: f64,
+    x: &[f64],
+    label: impl Fn(&'a str) -> &'a str,
+) -> Result<Vec<ContactView<'a>>> {
+    let mut ws = system.workspace();
+    let mut views = Vec::new();
+    for (name, &e) in contacts {
         let name = name.as_str();
-        let gap = action.gap(name, t, x)?;
         let ctx = system.element_context(&mut ws, t, x, e)?;
-        let contact = system.elements().nth(e).and_then(ContactElement::of);
-        let (shapes, point) = match contact {
+        let Some(element) = system.elements().nth(e) else {
+            continue;
+        };
+        let mut gap = [0.0];
+        if element.switch_count() > 0 {
+            element.switching_functions(&ctx, &mut gap);
+        }
+        let (shapes, point) = match ContactElement::of(element) {
             Some(c) => {
                 let shapes = c
                     .sides()
@@ -1137,26 +1166,15 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
             }
             None => (Vec::new(), None),
         };
-        let label = match (name, action.presser) {
-            ("presser_key", Some(p)) if p.carried => "finger_key",
-            ("presser_key", Some(_)) => "mass_key",
-            _ => name,
-        };
-        contacts.push(ContactView {
+        views.push(ContactView {
             name,
-            label,
+            label: label(name),
             shapes,
-            active: gap < 0.0,
+            active: gap[0] < 0.0,
             point,
         });
     }
-
-    let parts = build_parts(action, &rest);
-    let legend = format!(
-        "contact shapes of the {} model; white dots: pivots",
-        action.kind.name()
-    );
-    Ok(render(&parts, &carry, &contacts, &legend, title))
+    Ok(views)
 }
 
 /// The SVG document of `parts`, each carried from its rest place by its frame's motion in
@@ -1165,7 +1183,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
 /// contacts).
 fn render(
     parts: &[Part],
-    carry: &BTreeMap<&'static str, Transform>,
+    carry: &BTreeMap<String, Transform>,
     contacts: &[ContactView],
     legend: &str,
     title: &str,
@@ -1178,6 +1196,7 @@ fn render(
     // Rest layout → now, for a part.
     let carried = |part: &Part| {
         part.frame
+            .as_ref()
             .and_then(|f| carry.get(f).copied())
             .unwrap_or(Transform::IDENTITY)
     };
@@ -1373,11 +1392,18 @@ fn rest_and_carry(
     action: &Action,
     t: f64,
     x: &[f64],
-) -> Result<(
-    BTreeMap<&'static str, Transform>,
-    BTreeMap<&'static str, Transform>,
-)> {
-    let system = &action.system;
+) -> Result<(BTreeMap<String, Transform>, BTreeMap<String, Transform>)> {
+    rest_and_carry_of(&action.system, &drawn_frames(action), t, x)
+}
+
+/// [`rest_and_carry`] for the named frames of any system.
+#[allow(clippy::type_complexity)]
+fn rest_and_carry_of(
+    system: &mbs_core::System,
+    frames: &[&str],
+    t: f64,
+    x: &[f64],
+) -> Result<(BTreeMap<String, Transform>, BTreeMap<String, Transform>)> {
     let model = system.model();
     let mut rest_data = Data::new(model);
     update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
@@ -1385,18 +1411,18 @@ fn rest_and_carry(
     let mut carry = BTreeMap::new();
     let mut rest = BTreeMap::new();
     let ctx = system.kinematics(&mut ws, t, x)?;
-    for name in drawn_frames(action) {
+    for &name in frames {
         let id = model.frame_id(name)?;
         let x0 = frame_pose(model, &rest_data, id);
         let x1 = frame_pose(model, ctx.data, id);
-        rest.insert(name, x0);
-        carry.insert(name, x1.compose(&x0.inverse()));
+        rest.insert(name.to_string(), x0);
+        carry.insert(name.to_string(), x1.compose(&x0.inverse()));
     }
     Ok((rest, carry))
 }
 
 /// The parts of `action`, back to front, in their rest places.
-fn build_parts(action: &Action, rest: &BTreeMap<&'static str, Transform>) -> Vec<Part> {
+fn build_parts(action: &Action, rest: &BTreeMap<String, Transform>) -> Vec<Part> {
     let model = action.system.model();
     let is_body = |name: &str| model.body_id(name).is_ok();
     let jack_moves = is_body("jack");
@@ -1489,14 +1515,24 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
         rest_and_carry(action, 0.0, &x)?
     };
     let parts = parts_json(&build_parts(action, &rest));
-    // Contact shapes in their rest places (mm), by side.
-    let model = action.system.model();
+    Ok(serde_json::json!({
+        "frames": drawn_frames(action),
+        "parts": parts,
+        "contacts": rest_contacts_json(&action.system, &action.contacts)?,
+    }))
+}
+
+/// Every contact's shapes in their rest places (mm), by side with the frame that carries it.
+fn rest_contacts_json(
+    system: &mbs_core::System,
+    contacts_by_name: &BTreeMap<String, usize>,
+) -> Result<Vec<serde_json::Value>> {
+    let model = system.model();
     let mut contacts = Vec::new();
     let mut rest_data = Data::new(model);
     update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
-    for (name, &e) in &action.contacts {
-        let name = name.as_str();
-        let Some(c) = action.system.elements().nth(e).and_then(ContactElement::of) else {
+    for (name, &e) in contacts_by_name {
+        let Some(c) = system.elements().nth(e).and_then(ContactElement::of) else {
             continue;
         };
         let mut sides = Vec::new();
@@ -1532,11 +1568,7 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
         }
         contacts.push(serde_json::json!({"name": name, "sides": sides}));
     }
-    Ok(serde_json::json!({
-        "frames": drawn_frames(action),
-        "parts": parts,
-        "contacts": contacts,
-    }))
+    Ok(contacts)
 }
 
 /// For every drawn frame, the motion `[angle (rad), x (mm), y (mm)]` carrying its parts from
@@ -1547,4 +1579,250 @@ pub fn carry(action: &Action, t: f64, x: &[f64]) -> Result<Vec<(&'static str, [f
         .into_iter()
         .filter_map(|f| carry.get(f).map(|c| (f, [c.angle(), c.x * 1e3, c.y * 1e3])))
         .collect())
+}
+
+// ------------------------------------------------------------ any mechanism, from outlines
+
+/// Fill colours of bodies that name none, in body order.
+const BODY_FILLS: [&str; 8] = [
+    KEY_FILL,
+    WIPPEN_FILL,
+    JACK_FILL,
+    LEVER_FILL,
+    SHANK_FILL,
+    MOLDING_FILL,
+    BRASS_FILL,
+    FELT_FILL,
+];
+
+/// The drawn frames of a mechanism: every body, in order.
+fn mechanism_frames(mechanism: &Mechanism) -> Vec<&str> {
+    mechanism.bodies.iter().map(|b| b.name.as_str()).collect()
+}
+
+/// One outline part placed by `pose` (m) as a drawn piece (mm).
+fn outline_piece(part: &mut Part, o: &OutlinePart, pose: &Transform, fill: &str) {
+    let fill = o.color.as_deref().unwrap_or(fill);
+    if let Some(c) = o.circle {
+        part.circle(
+            mul(pose.transform_point(c.center), 1e3),
+            c.radius * 1e3,
+            fill,
+        );
+    } else {
+        let pts = o
+            .points
+            .iter()
+            .map(|&p| mul(pose.transform_point(p), 1e3))
+            .collect();
+        part.polygon(pts, fill);
+    }
+}
+
+/// The parts of a mechanism drawn from its outlines, in their rest places (world mm): the
+/// ground's outlines first (`fixed-parts`), then each body's (`body-<name>`) with a white
+/// dot at a revolute joint's pivot and the body's name beside it.
+fn mechanism_parts(mechanism: &Mechanism, rest: &BTreeMap<String, Transform>) -> Vec<Part> {
+    // Fixed parts behind the mechanism's plane (a bracket between keys) first, seen
+    // through it (pale, dashed); then the others.
+    let mut behind = Part::new("fixed-behind", None);
+    behind.behind = true;
+    let mut ground = Part::new("fixed-parts", None);
+    for o in &mechanism.ground {
+        let part = if o.z + 0.5 * o.thickness < 0.0 {
+            &mut behind
+        } else {
+            &mut ground
+        };
+        outline_piece(part, o, &Transform::IDENTITY, RAIL_FILL);
+    }
+    let mut parts = vec![behind, ground];
+    for (i, body) in mechanism.bodies.iter().enumerate() {
+        let Some(pose) = rest.get(&body.name) else {
+            continue;
+        };
+        let mut part = Part::new(&format!("body-{}", body.name), Some(&body.name));
+        let fill = BODY_FILLS[i % BODY_FILLS.len()];
+        for o in &body.outline {
+            outline_piece(&mut part, o, pose, fill);
+        }
+        let origin = mul(pose.transform_point([0.0, 0.0]), 1e3);
+        if body.joint.kind == mbs_mechanism::JointType::Revolute {
+            part.pivots.push(origin);
+        }
+        let com = mul(pose.transform_point(body.com), 1e3);
+        part.label(com, [0.0, 6.0], body.name.replace('_', " "), "middle");
+        parts.push(part);
+    }
+    parts
+}
+
+/// Draws a mechanism built from its description (`built`) from the outlines, to scale, at
+/// time `t` and state `x`: an SVG document in millimetres, with the contact shapes and the
+/// pressed contacts marked as in [`action_svg`].
+pub fn mechanism_svg(
+    mechanism: &Mechanism,
+    built: &Built,
+    t: f64,
+    x: &[f64],
+    title: &str,
+) -> Result<String> {
+    if !t.is_finite() {
+        return Err(CoreError::NonFiniteInput {
+            what: "t",
+            index: 0,
+            value: t,
+        }
+        .into());
+    }
+    let frames = mechanism_frames(mechanism);
+    let (rest, carry) = rest_and_carry_of(&built.system, &frames, t, x)?;
+    let contacts = contact_views(&built.system, &built.contacts, t, x, |n| n)?;
+    let parts = mechanism_parts(mechanism, &rest);
+    let legend = format!("{}: contact shapes; white dots: pivots", mechanism.name);
+    Ok(render(&parts, &carry, &contacts, &legend, title))
+}
+
+/// The drawing of a mechanism as data for the report (as [`scene`] for the grand action):
+/// its outlines in their rest places, with each part's thickness and plane for the 3D
+/// view.
+pub fn mechanism_scene(mechanism: &Mechanism, built: &Built) -> Result<serde_json::Value> {
+    let frames = mechanism_frames(mechanism);
+    let x = built.layout_state()?;
+    let (rest, _) = rest_and_carry_of(&built.system, &frames, 0.0, &x)?;
+    let parts = mechanism_parts(mechanism, &rest);
+    let mut parts_json = parts_json(&parts);
+    // Thickness and plane (mm) of every part, from its outlines (the thickest, the mean
+    // plane), for the 3D view.
+    let (back, front): (Vec<OutlinePart>, Vec<OutlinePart>) = mechanism
+        .ground
+        .iter()
+        .cloned()
+        .partition(|o| o.z + 0.5 * o.thickness < 0.0);
+    let outlines: Vec<&[OutlinePart]> = [back.as_slice(), front.as_slice()]
+        .into_iter()
+        .chain(mechanism.bodies.iter().map(|b| b.outline.as_slice()))
+        .collect();
+    for (json, outline) in parts_json.iter_mut().zip(outlines) {
+        if let Some(obj) = json.as_object_mut()
+            && !outline.is_empty()
+        {
+            let thick = outline.iter().map(|o| o.thickness).fold(0.0, f64::max);
+            let z = outline.iter().map(|o| o.z).sum::<f64>() / outline.len() as f64;
+            obj.insert("thickness".into(), serde_json::json!(round(thick * 1e3)));
+            obj.insert("z".into(), serde_json::json!(round(z * 1e3)));
+        }
+    }
+    Ok(serde_json::json!({
+        "frames": frames,
+        "parts": parts_json,
+        "contacts": rest_contacts_json(&built.system, &built.contacts)?,
+    }))
+}
+
+/// For every body of a mechanism, the motion `[angle (rad), x (mm), y (mm)]` carrying its
+/// parts from their rest places to where they are at `(t, x)`.
+pub fn mechanism_carry(
+    mechanism: &Mechanism,
+    built: &Built,
+    t: f64,
+    x: &[f64],
+) -> Result<Vec<(String, [f64; 3])>> {
+    let frames = mechanism_frames(mechanism);
+    let (_, carry) = rest_and_carry_of(&built.system, &frames, t, x)?;
+    Ok(frames
+        .into_iter()
+        .filter_map(|f| {
+            carry
+                .get(f)
+                .map(|c| (f.to_string(), [c.angle(), c.x * 1e3, c.y * 1e3]))
+        })
+        .collect())
+}
+
+/// Thickness of the grand action's drawn parts across the plane (mm) \[M\]: the key 22 mm
+/// wide, the wippen and hammer 14 mm, the jack 8 mm; the fixed rails span the keys.
+const GRAND_THICKNESS_MM: [(&str, f64); 10] = [
+    ("fixed-parts", 36.0),
+    ("body-key", 22.0),
+    ("body-wippen", 14.0),
+    ("body-jack", 8.0),
+    ("body-repetition_lever", 10.0),
+    ("body-hammer", 14.0),
+    ("key-backcheck", 14.0),
+    ("body-presser", 14.0),
+    ("key-capstan", 8.0),
+    ("action-bracket", 10.0),
+];
+
+/// The grand action's drawing as description outlines: the ground's (world, m) and each
+/// body's (its frame, m), with their colours and thicknesses, so that a description
+/// written by `piano describe` draws like the built-in model.
+#[allow(clippy::type_complexity)]
+pub fn grand_outlines(
+    action: &Action,
+) -> Result<(Vec<OutlinePart>, BTreeMap<String, Vec<OutlinePart>>)> {
+    let x = action.layout_state()?;
+    let (rest, _) = rest_and_carry(action, 0.0, &x)?;
+    let mut ground = Vec::new();
+    let mut bodies: BTreeMap<String, Vec<OutlinePart>> = BTreeMap::new();
+    for part in build_parts(action, &rest) {
+        let thickness = GRAND_THICKNESS_MM
+            .iter()
+            .find(|(id, _)| *id == part.id)
+            .map_or(10.0, |(_, t)| *t)
+            * 1e-3;
+        // World mm at rest → the frame's coordinates in m.
+        let inverse = part
+            .frame
+            .as_ref()
+            .and_then(|f| rest.get(f))
+            .map_or(Transform::IDENTITY, |x0| x0.inverse());
+        let local = |q: P| inverse.transform_point(mul(q, 1e-3));
+        let z = if part.behind { -0.04 } else { 0.0 };
+        let mut out = Vec::new();
+        for (piece, fill) in &part.pieces {
+            let mut o = OutlinePart {
+                name: part.id.clone(),
+                points: Vec::new(),
+                circle: None,
+                thickness,
+                z,
+                color: Some(fill.clone()),
+            };
+            match piece {
+                Outline::Polygon(pts) => {
+                    o.points = pts.iter().map(|&q| local(q)).collect();
+                    out.push(o);
+                }
+                Outline::Circle(c, r) => {
+                    o.circle = Some(mbs_mechanism::CircleSpec {
+                        center: local(*c),
+                        radius: r * 1e-3,
+                    });
+                    out.push(o);
+                }
+                Outline::Wire(pts, width) => {
+                    // Each stretch of wire as a thin quadrilateral.
+                    for w in pts.windows(2) {
+                        let d = unit(sub(w[1], w[0]), [1.0, 0.0]);
+                        let n = mul([-d[1], d[0]], 0.5 * width);
+                        let mut q = o.clone();
+                        q.points = [add(w[0], n), add(w[1], n), sub(w[1], n), sub(w[0], n)]
+                            .into_iter()
+                            .map(local)
+                            .collect();
+                        q.thickness = (width * 1e-3).max(1.5e-3);
+                        out.push(q);
+                    }
+                }
+            }
+        }
+        out.retain(|o| o.circle.is_some() || o.points.len() >= 3);
+        match &part.frame {
+            None => ground.extend(out),
+            Some(f) => bodies.entry(f.clone()).or_default().extend(out),
+        }
+    }
+    Ok((ground, bodies))
 }

@@ -28,6 +28,7 @@ pub mod fuzzing;
 pub mod geometry_check;
 pub mod identify;
 pub mod measured;
+pub mod mechanism_run;
 pub mod param_paths;
 pub mod params;
 pub mod pendulum;
@@ -42,7 +43,7 @@ pub mod toml_lines;
 pub mod touchweight;
 pub mod validate;
 
-pub use action::{Action, ContactElement, ModelKind, Presser};
+pub use action::{Action, ContactElement, ModelKind, Presser, integrate_system};
 pub use drawing::action_svg;
 pub use error::{InputError, InputKind, PianoError, Result};
 pub use params::ActionParams;

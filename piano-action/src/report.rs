@@ -35,12 +35,12 @@ fn read(dir: &Path, name: &str) -> Result<String> {
         .map_err(|e| bad(dir, format!("cannot read {name}: {e}")))
 }
 
-fn read_json(dir: &Path, name: &str) -> Result<Value> {
+pub(crate) fn read_json(dir: &Path, name: &str) -> Result<Value> {
     serde_json::from_str(&read(dir, name)?).map_err(|e| bad(dir, format!("{name}: {e}")))
 }
 
 /// Rounds `v` to `digits` decimals (keeps the embedded data small).
-fn r(v: f64, digits: i32) -> f64 {
+pub(crate) fn r(v: f64, digits: i32) -> f64 {
     let s = 10f64.powi(digits);
     let out = (v * s).round() / s;
     if out == 0.0 { 0.0 } else { out }
@@ -52,7 +52,7 @@ fn read_trajectory(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
 }
 
 /// A CSV of finite numbers with a header line: header and rows.
-fn read_numeric_csv(dir: &Path, name: &str) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
+pub(crate) fn read_numeric_csv(dir: &Path, name: &str) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
     let text = read(dir, name)?;
     let mut lines = text.lines();
     let header: Vec<String> = lines
@@ -87,7 +87,7 @@ fn read_numeric_csv(dir: &Path, name: &str) -> Result<(Vec<String>, Vec<Vec<f64>
 }
 
 /// A short description of a scenario's input, for titles and legends.
-fn describe(input: &InputSpec) -> String {
+pub(crate) fn describe(input: &InputSpec) -> String {
     match input {
         InputSpec::Force(ForceSpec {
             force_n: Some(f), ..
@@ -168,14 +168,14 @@ fn contact_label(name: &str, input: &InputSpec) -> String {
 }
 
 /// A run's name on the page: its folder's name.
-fn run_name(dir: &Path) -> String {
+pub(crate) fn run_name(dir: &Path) -> String {
     dir.file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| dir.display().to_string())
 }
 
 /// Plotted series as the page reads them: `[{id, label, values}]`.
-fn series_to_json(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Value> {
+pub(crate) fn series_to_json(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Value> {
     series
         .into_iter()
         .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
@@ -185,6 +185,9 @@ fn series_to_json(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Value> {
 /// The report data of one run directory (see the module docs).
 pub fn run_data(dir: &Path) -> Result<Value> {
     let run = read_json(dir, "run.json")?;
+    if run.get("mechanism").is_some() {
+        return crate::mechanism_run::report_data(dir, &run);
+    }
     let scenario: Scenario = serde_json::from_value(run["scenario"].clone())
         .map_err(|e| bad(dir, format!("run.json scenario: {e}")))?;
     let params: ActionParams = serde_json::from_value(run["params"].clone())

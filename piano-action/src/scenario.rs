@@ -6,6 +6,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use mbs_integrators::Solution;
+
 use crate::action::ModelKind;
 use crate::error::{InputKind, PianoError, Result};
 use crate::params::ActionParams;
@@ -392,8 +394,17 @@ pub fn read_points_csv_lines(text: &str, file: &Path) -> Result<(Vec<[f64; 2]>, 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
-    /// `"simplified"`, `"single"` or `"double"`.
+    /// `"simplified"`, `"single"` or `"double"`; empty when `mechanism` is given.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub model: String,
+    /// A mechanism description (TOML or JSON, relative to the scenario's folder) to run in
+    /// place of a grand `model` (see [`crate::mechanism_run`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanism: Option<String>,
+    /// How long a mechanism settles at rest before the input starts (s; mechanism
+    /// scenarios only, [`crate::mechanism_run::DEFAULT_SETTLE_S`] by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_s: Option<f64>,
     /// Simulated time (s).
     pub duration_s: f64,
     /// Output grid spacing (s); 1 ms by default.
@@ -401,6 +412,9 @@ pub struct Scenario {
     pub output_step_s: f64,
     /// What drives the key.
     pub input: InputSpec,
+    /// The description `mechanism` names, as [`Scenario::load`] read it.
+    #[serde(skip)]
+    pub loaded_mechanism: Option<mbs_mechanism::Mechanism>,
 }
 
 fn default_output_step() -> f64 {
@@ -415,7 +429,10 @@ impl Scenario {
         #[derive(Deserialize)]
         #[serde(deny_unknown_fields)]
         struct File {
+            #[serde(default)]
             model: String,
+            mechanism: Option<String>,
+            settle_s: Option<f64>,
             duration_s: f64,
             #[serde(default = "default_output_step")]
             output_step_s: f64,
@@ -424,9 +441,12 @@ impl Scenario {
         let file: File = from_toml(text, InputKind::Scenario)?;
         let scenario = Scenario {
             model: file.model,
+            mechanism: file.mechanism,
+            settle_s: file.settle_s,
             duration_s: file.duration_s,
             output_step_s: file.output_step_s,
             input: input_from_table(file.input).map_err(|e| e.locate_in_toml(text))?,
+            loaded_mechanism: None,
         };
         scenario.check().map_err(|e| e.locate_in_toml(text))?;
         Ok(scenario)
@@ -435,6 +455,15 @@ impl Scenario {
     /// Checks what can be checked before running: the model, the duration and output step,
     /// and the input's values (a motion's `csv` is checked when [`Scenario::load`] reads it).
     pub fn check(&self) -> Result<()> {
+        if self.mechanism.is_some() {
+            return self.check_mechanism_scenario();
+        }
+        if self.settle_s.is_some() {
+            return Err(PianoError::scenario(
+                "settle_s",
+                "belongs to a mechanism scenario (a grand model settles on its own)",
+            ));
+        }
         // The pendulum uses the hammer alone, but the model must still be one of ours.
         self.model_kind()?;
         if let InputSpec::Pendulum(PendulumSpec { release_angle_deg }) = self.input {
@@ -458,12 +487,53 @@ impl Scenario {
         }
     }
 
+    /// The checks of a scenario with `mechanism`: no `model`, a force input, a sensible
+    /// settling time.
+    fn check_mechanism_scenario(&self) -> Result<()> {
+        if !self.model.is_empty() {
+            return Err(PianoError::scenario(
+                "model",
+                "give either `model` (a grand action) or `mechanism` (a description file), \
+                 not both",
+            ));
+        }
+        if let Some(s) = self.settle_s
+            && !(s.is_finite() && (0.0..=crate::simulate::MAX_DURATION_S).contains(&s))
+        {
+            return Err(PianoError::scenario(
+                "settle_s",
+                format!("must be 0-{} s, got {s}", crate::simulate::MAX_DURATION_S),
+            ));
+        }
+        crate::simulate::check_duration(self.duration_s, self.output_step_s)?;
+        match &self.input {
+            InputSpec::Force(_) => self.input.to_input()?.validate(),
+            _ => Err(PianoError::scenario(
+                "input.kind",
+                "a mechanism description is driven by a force (kind = \"force\"); mass \
+                 drops, touches, key motions and the swing test belong to the grand models",
+            )),
+        }
+    }
+
     /// Reads and parses the scenario file at `path`, and reads a motion's `csv` (relative to
     /// the scenario's folder) into its points. Errors name the file, the line and the field.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| PianoError::file(path, format!("cannot read the scenario: {e}")))?;
         let mut scenario = Self::from_toml_str(&text).map_err(|e| e.in_file(path))?;
+        if let Some(file) = &scenario.mechanism {
+            let full = path.parent().unwrap_or(Path::new(".")).join(file);
+            if !full.is_file() {
+                return Err(PianoError::scenario(
+                    "mechanism",
+                    format!("cannot read the mechanism description {}", full.display()),
+                )
+                .in_file(path)
+                .locate_in_toml(&text));
+            }
+            scenario.loaded_mechanism = Some(mbs_mechanism::Mechanism::load(&full)?);
+        }
         if let InputSpec::Motion(MotionSpec {
             points,
             csv: Some(file),
@@ -505,6 +575,12 @@ impl Scenario {
 
     /// The model kind named by `model`.
     pub fn model_kind(&self) -> Result<ModelKind> {
+        if self.model.is_empty() && self.mechanism.is_some() {
+            return Err(PianoError::scenario(
+                "model",
+                "this scenario runs a mechanism description, not a grand model",
+            ));
+        }
         ModelKind::ALL
             .into_iter()
             .find(|k| k.name() == self.model)
@@ -568,6 +644,8 @@ pub fn is_run_output(name: &str) -> bool {
             | "trajectory.csv"
             | INTERNAL_STATES_CSV
             | "contacts.csv"
+            | "poses.csv"
+            | "series.csv"
             | "events.json"
             | "summary.json"
             | "report.html"
@@ -689,50 +767,16 @@ pub fn write_run_dir(
     // The action as the run had it (with a presser, if any), for the names, the contacts
     // and the drawings.
     let prepared = crate::simulate::prepare(params, run.kind, &scenario.input.to_input()?)?;
-    let names = prepared.action.system.model().coordinate_names().to_vec();
     let sol = &run.solution;
-    let nv = names.len();
-    let mut csv = String::from("time_s");
-    for n in &names {
-        let _ = write!(csv, ",{n}_q");
-    }
-    for n in names {
-        let _ = write!(csv, ",{n}_v");
-    }
-    let with_force = run.key_drive_force_n.len() == sol.len();
-    if with_force {
-        csv.push_str(",key_drive_force_n");
-    }
-    csv.push('\n');
-    for i in 0..sol.len() {
-        let _ = write!(csv, "{}", sol.t[i]);
-        for v in &sol.state(i)[..2 * nv] {
-            let _ = write!(csv, ",{v}");
-        }
-        if with_force {
-            let _ = write!(csv, ",{}", run.key_drive_force_n[i]);
-        }
-        csv.push('\n');
-    }
-    write_file(dir, "trajectory.csv", &csv)?;
-    // The force elements' internal states (the string's modal amplitudes) on the same
-    // grid, so that the report sees the string where the run left it.
-    let internal = prepared.action.system.state_len().saturating_sub(2 * nv);
-    if internal > 0 {
-        let mut csv = String::from("time_s");
-        for k in 0..internal {
-            let _ = write!(csv, ",state_{}", 2 * nv + k);
-        }
-        csv.push('\n');
-        for i in 0..sol.len() {
-            let _ = write!(csv, "{}", sol.t[i]);
-            for v in &sol.state(i)[2 * nv..] {
-                let _ = write!(csv, ",{v}");
-            }
-            csv.push('\n');
-        }
-        write_file(dir, INTERNAL_STATES_CSV, &csv)?;
-    }
+    let extra = (run.key_drive_force_n.len() == sol.len())
+        .then_some(("key_drive_force_n", run.key_drive_force_n.as_slice()));
+    write_trajectory(
+        dir,
+        prepared.action.system.model().coordinate_names(),
+        prepared.action.system.state_len(),
+        sol,
+        extra,
+    )?;
     write_contacts_and_drawings(dir, &prepared, run)?;
 
     let events: Vec<serde_json::Value> = run
@@ -770,6 +814,59 @@ pub fn write_run_dir(
         "events": events,
     });
     write_json(dir, "summary.json", &summary)?;
+    Ok(())
+}
+
+/// Writes `trajectory.csv` (time, then `<name>_q` and `<name>_v` for every coordinate in
+/// `names`, then the `extra` column if given) and, when the state holds more than the
+/// coordinates and velocities (`state_len`), [`INTERNAL_STATES_CSV`] with the force
+/// elements' internal states (the string's modal amplitudes) on the same grid.
+pub fn write_trajectory(
+    dir: &Path,
+    names: &[String],
+    state_len: usize,
+    sol: &Solution,
+    extra: Option<(&str, &[f64])>,
+) -> Result<()> {
+    let nv = names.len();
+    let mut csv = String::from("time_s");
+    for n in names {
+        let _ = write!(csv, ",{n}_q");
+    }
+    for n in names {
+        let _ = write!(csv, ",{n}_v");
+    }
+    if let Some((name, _)) = extra {
+        let _ = write!(csv, ",{name}");
+    }
+    csv.push('\n');
+    for i in 0..sol.len() {
+        let _ = write!(csv, "{}", sol.t[i]);
+        for v in &sol.state(i)[..2 * nv] {
+            let _ = write!(csv, ",{v}");
+        }
+        if let Some((_, values)) = extra {
+            let _ = write!(csv, ",{}", values[i]);
+        }
+        csv.push('\n');
+    }
+    write_file(dir, "trajectory.csv", &csv)?;
+    let internal = state_len.saturating_sub(2 * nv);
+    if internal > 0 {
+        let mut csv = String::from("time_s");
+        for k in 0..internal {
+            let _ = write!(csv, ",state_{}", 2 * nv + k);
+        }
+        csv.push('\n');
+        for i in 0..sol.len() {
+            let _ = write!(csv, "{}", sol.t[i]);
+            for v in &sol.state(i)[2 * nv..] {
+                let _ = write!(csv, ",{v}");
+            }
+            csv.push('\n');
+        }
+        write_file(dir, INTERNAL_STATES_CSV, &csv)?;
+    }
     Ok(())
 }
 

@@ -102,6 +102,20 @@ fn piano_describe_writes_a_commented_description() {
     m.validate().unwrap();
     assert_eq!(
         m,
+        piano_action::describe::grand_description(&ActionParams::reference(), ModelKind::Single)
+            .unwrap()
+    );
+    // The physics is grand_mechanism's; the drawing's outlines, events and metrics are added.
+    let mut physics = m.clone();
+    physics.ground.clear();
+    physics.events.clear();
+    physics.metrics.clear();
+    for b in &mut physics.bodies {
+        assert!(!b.outline.is_empty(), "{} has an outline", b.name);
+        b.outline.clear();
+    }
+    assert_eq!(
+        physics,
         grand_mechanism(&ActionParams::reference(), ModelKind::Single, None).unwrap()
     );
     assert!(m.contacts.iter().any(|c| c.name == "let_off_button"));
@@ -123,5 +137,191 @@ fn piano_describe_writes_a_commented_description() {
     let (ok, _, err) = piano(&["describe", "--out", out.to_str().unwrap(), "--force"]);
     assert!(ok, "{err}");
     assert!(Mechanism::load(&out).is_ok());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A scenario file in `dir`.
+fn scenario(dir: &std::path::Path, name: &str, head: &str, input: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(
+        &path,
+        format!("{head}\nduration_s = 0.06\noutput_step_s = 5e-4\n[input]\n{input}\n"),
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn a_scenario_runs_a_description_file_like_the_built_in_model() {
+    let dir = std::env::temp_dir().join(format!("piano-mechanism-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let grand_file = dir.join("grand.toml");
+    let (ok, _, err) = piano(&["describe", "--out", grand_file.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let force = "kind = \"force\"\nforce_n = 12.0";
+    let by_file = scenario(&dir, "file.toml", "mechanism = \"grand.toml\"", force);
+    let by_model = scenario(&dir, "model.toml", "model = \"double\"", force);
+    let (a, b) = (dir.join("run_file"), dir.join("run_model"));
+    let (ok, out, err) = piano(&[
+        "simulate",
+        by_file.to_str().unwrap(),
+        "--out",
+        a.to_str().unwrap(),
+        "--report",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("strike"), "{out}");
+    let (ok, _, err) = piano(&[
+        "simulate",
+        by_model.to_str().unwrap(),
+        "--out",
+        b.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    // The same trajectory, bit for bit (the numbers are printed to the last digit).
+    for file in ["trajectory.csv", "internal_states.csv"] {
+        assert_eq!(
+            std::fs::read_to_string(a.join(file)).unwrap(),
+            std::fs::read_to_string(b.join(file)).unwrap(),
+            "{file}"
+        );
+    }
+    // The description's events and metrics agree with the grand analysis.
+    let read = |p: std::path::PathBuf| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let grand = read(b.join("summary.json"));
+    let described = read(a.join("summary.json"));
+    let strike = &grand["strikes"][0];
+    let metric = |name: &str| {
+        described["metrics"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["name"] == name)
+            .and_then(|m| m["value"].as_f64())
+            .unwrap()
+    };
+    assert_eq!(metric("strike time"), strike["time_s"].as_f64().unwrap());
+    let (v_file, v_grand) = (
+        metric("hammer speed at the strike"),
+        strike["hammer_velocity_m_s"].as_f64().unwrap(),
+    );
+    assert!(
+        (v_file - v_grand).abs() < 1e-12 * v_grand,
+        "{v_file} vs {v_grand}"
+    );
+    assert_eq!(
+        metric("let-off time"),
+        grand["let_off_time_s"].as_f64().unwrap()
+    );
+    // Self-contained: the description, poses and contact outputs are in the folder, and
+    // the drawings at the named events exist.
+    let run = read(a.join("run.json"));
+    assert_eq!(run["mechanism"]["name"], "grand action, double model");
+    for file in [
+        "poses.csv",
+        "series.csv",
+        "contacts.csv",
+        "drawing_rest.svg",
+        "drawing_strike.svg",
+        "drawing_check.svg",
+        "report.html",
+    ] {
+        assert!(a.join(file).is_file(), "{file}");
+    }
+    let svg = std::fs::read_to_string(a.join("drawing_strike.svg")).unwrap();
+    assert!(svg.contains("id=\"body-hammer\"") && svg.contains("id=\"active-hammer_string\""));
+    let html = std::fs::read_to_string(a.join("report.html")).unwrap();
+    assert!(html.contains("hammer speed at the strike"));
+    // The report replays the run from its files: it reads again after the description
+    // file is gone.
+    std::fs::remove_file(&grand_file).unwrap();
+    let (ok, _, err) = piano(&["report", a.to_str().unwrap(), "--force"]);
+    assert!(ok, "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn mechanism_scenarios_refuse_what_they_cannot_run() {
+    let dir = std::env::temp_dir().join(format!("piano-mechanism-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let force = "kind = \"force\"\nforce_n = 5.0";
+    let run = |path: &std::path::Path| {
+        let (ok, _, err) = piano(&[
+            "simulate",
+            path.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        assert!(!ok);
+        err
+    };
+    let err = run(&scenario(
+        &dir,
+        "both.toml",
+        "model = \"double\"\nmechanism = \"m.toml\"",
+        force,
+    ));
+    assert!(
+        err.contains("field `model`") && err.contains("not both"),
+        "{err}"
+    );
+    let err = run(&scenario(
+        &dir,
+        "missing.toml",
+        "mechanism = \"nowhere.toml\"",
+        force,
+    ));
+    assert!(
+        err.contains("field `mechanism`") && err.contains("nowhere.toml"),
+        "{err}"
+    );
+    let touch = "kind = \"touch\"\nstyle = \"struck\"\nfinger_speed_m_s = 1.0";
+    let err = run(&scenario(
+        &dir,
+        "touch.toml",
+        "mechanism = \"m.toml\"",
+        touch,
+    ));
+    assert!(err.contains("input.kind"), "{err}");
+    let err = run(&scenario(
+        &dir,
+        "settle.toml",
+        "model = \"double\"\nsettle_s = 0.1",
+        force,
+    ));
+    assert!(err.contains("settle_s"), "{err}");
+    // A broken description: its own file, line and field.
+    std::fs::write(
+        dir.join("m.toml"),
+        "name = \"m\"\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"a\"\nmass = -1.0\n\
+         com = [0.0, 0.0]\ninertia = 1e-4\njoint = { kind = \"revolute\", at = [0.0, 0.0] }\n",
+    )
+    .unwrap();
+    let err = run(&scenario(
+        &dir,
+        "broken.toml",
+        "mechanism = \"m.toml\"",
+        force,
+    ));
+    assert!(
+        err.contains("m.toml:5") && err.contains("bodies[0].mass"),
+        "{err}"
+    );
+    // A description without a force input.
+    std::fs::write(
+        dir.join("m.toml"),
+        "name = \"m\"\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"a\"\nmass = 1.0\n\
+         com = [0.0, 0.0]\ninertia = 1e-4\njoint = { kind = \"revolute\", at = [0.0, 0.0] }\n",
+    )
+    .unwrap();
+    let err = run(&scenario(
+        &dir,
+        "noinput.toml",
+        "mechanism = \"m.toml\"",
+        force,
+    ));
+    assert!(err.contains("no force input"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -40,6 +40,8 @@
   // A contact's name for a reader (the presser's pad is a finger's or a mass's).
   const contactLabel = (run, name) => (run.contact_labels || {})[name] || name.replace(/_/g, ' ');
   const fmtMs = (t) => (t * 1e3).toFixed(2) + ' ms';
+  // A contact's colour: the run's own (a mechanism description's), else the action's.
+  const contactColor = (run, name, fallback) => (run.contact_colors || {})[name] || CONTACT_COLORS[name] || fallback;
 
   // Index i and weight u with t between run.t[i] and run.t[i + 1].
   function locate(run, t) {
@@ -65,6 +67,11 @@
       const p = s.pendulum;
       return r.name + ': ' + p.turns.length + ' turning points, period ' +
         (p.period_s ? p.period_s.toFixed(3) + ' s' : '–') + ' (small swings: ' + p.small_amplitude_period_s.toFixed(3) + ' s)';
+    }
+    if (s.metrics) {
+      // A mechanism description's run: its metrics.
+      return r.name + ': ' + (s.metrics.length ? s.metrics.map((m) => m.name + ' ' +
+        (m.value === null ? '–' : m.value.toPrecision(4) + ' ' + m.unit)).join(', ') : 'no metrics');
     }
     const first = (s.strikes || [])[0];
     const v = first ? first.hammer_velocity_m_s.toFixed(2) + ' m/s at ' + fmtMs(first.time_s) : 'no strike';
@@ -326,7 +333,7 @@
       const k = u > 0.5 && i + 1 < c.f.length ? i + 1 : i;
       const f = lerp(c.f, i, u);
       if (!(c.f[k] > 0) || !(f > 0)) continue;
-      active.push({ name, f, p: [c.px[k], c.py[k]], n: [c.nx[k], c.ny[k]], color: CONTACT_COLORS[name] || '#c0392b' });
+      active.push({ name, f, p: [c.px[k], c.py[k]], n: [c.nx[k], c.ny[k]], color: contactColor(run, name, '#c0392b') });
     }
     // Text in screen space. Every label is placed where it overlaps no other and stays on
     // the canvas (see placeLabel); what is written where is kept for tests.
@@ -555,8 +562,9 @@
     if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
     const meshes = [];
     for (const part of run.scene.parts) {
-      const h = THICKNESS[part.id] || 10;
-      const zc = part.behind ? BEHIND_Z : 0;
+      // A description's part carries its own thickness and plane (mm).
+      const h = part.thickness || THICKNESS[part.id] || 10;
+      const zc = part.behind ? BEHIND_Z : (part.z || 0);
       for (const pc of part.pieces) {
         const data = [];
         if (pc.kind === 'polygon') extrude(pc.pts, h, data, zc);
@@ -670,7 +678,7 @@
   RUNS.forEach((r, k) => {
     for (const [name, c] of Object.entries(r.contacts)) {
       if (!c.f.some((f) => f > 0)) continue;
-      forceLines.push({ run: k, label: contactLabel(r, name) + (RUNS.length > 1 ? ' [' + (k + 1) + ']' : ''), values: c.f, color: CONTACT_COLORS[name] || '#333', dash: k ? [5, 3] : [] });
+      forceLines.push({ run: k, label: contactLabel(r, name) + (RUNS.length > 1 ? ' [' + (k + 1) + ']' : ''), values: c.f, color: contactColor(r, name, '#333'), dash: k ? [5, 3] : [] });
     }
   });
   plotDefs.push({ id: 'contact-forces', title: 'Contact forces (N)', lines: forceLines });
@@ -680,6 +688,15 @@
   ]) });
   if (RUNS.some((r) => seriesOf(r, 'key_drive_force_n'))) {
     plotDefs.push({ id: 'hand-force', title: 'Hand force at the key front (N)', lines: RUNS.map((r, k) => ({ run: k, id: 'key_drive_force_n', label: r.name, values: seriesOf(r, 'key_drive_force_n'), color: RUN_COLORS[k % 6] })).filter((l) => l.values) });
+  }
+  // A mechanism description's own series (coordinates, marker speeds): one plot each.
+  const shown = new Set(['hammer_angle_deg', 'hammer_speed_m_s', 'key_depth_mm', 'kinetic_mj', 'gravity_mj', 'key_drive_force_n']);
+  for (const r of RUNS) {
+    for (const s of r.series) {
+      if (shown.has(s.id)) continue;
+      shown.add(s.id);
+      plotDefs.push({ id: s.id.replace(/[^a-z0-9]+/gi, '-'), title: s.label.charAt(0).toUpperCase() + s.label.slice(1), lines: RUNS.map((q, k) => ({ run: k, id: s.id, label: q.name, values: seriesOf(q, s.id), color: RUN_COLORS[k % 6] })) });
+    }
   }
   // Plots of quantities no run has (a pendulum has no key, no contacts) are left out.
   const plots = plotDefs.filter((def) => def.lines.some((l) => l.values && l.values.length)).map((def) => {
