@@ -519,9 +519,14 @@ struct SweepArgs {
     /// Space the levels evenly rather than on a log scale.
     #[arg(long)]
     linear: bool,
-    /// Which model.
-    #[arg(long, default_value = "double")]
-    model: String,
+    /// Which model (`double` by default).
+    #[arg(long)]
+    model: Option<String>,
+    /// A mechanism description (TOML or JSON) to sweep instead of a grand model: a constant
+    /// force on its first force input (`--touch force`); the CSV holds its metrics and the
+    /// first time of each named event.
+    #[arg(long, value_name = "FILE")]
+    mechanism: Option<std::path::PathBuf>,
     /// Simulated time per run (s).
     #[arg(long, default_value_t = 0.3, allow_negative_numbers = true)]
     duration: f64,
@@ -553,7 +558,23 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
         SweepKind::Pressed => (0.7, 50.0),
         SweepKind::Struck => (0.08, 2.0),
     };
-    let model = model_kind(&a.model)?;
+    let mechanism = match &a.mechanism {
+        None => None,
+        Some(path) => {
+            if a.model.is_some() {
+                return Err("option --model: give either --model or --mechanism".into());
+            }
+            if kind != SweepKind::Force {
+                return Err(format!(
+                    "option --touch: a mechanism description is swept by a force (--touch \
+                     force), not '{}'",
+                    a.touch
+                ));
+            }
+            Some(piano_action::mechanism::Mechanism::load(path).map_err(|e| e.to_string())?)
+        }
+    };
+    let model = model_kind(a.model.as_deref().unwrap_or("double"))?;
     piano_action::simulate::check_duration(a.duration, 1e-3).map_err(|e| {
         format!(
             "option --duration: {}",
@@ -583,6 +604,28 @@ fn sweep(params: &ActionParams, a: SweepArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?,
     );
     let start = std::time::Instant::now();
+    if let Some(mechanism) = &mechanism {
+        let rows = pool.install(|| {
+            piano_action::sweep::sweep_mechanism(mechanism, params, &values, a.duration, &|| {
+                bar.inc(1)
+            })
+        });
+        bar.finish_and_clear();
+        let wall = start.elapsed().as_secs_f64();
+        std::fs::write(&a.out, piano_action::sweep::mechanism_csv(mechanism, &rows))
+            .map_err(|e| format!("{}: cannot write: {e}", a.out.display()))?;
+        let failed = rows.iter().filter(|r| r.run.is_err()).count();
+        println!(
+            "{} force runs of {} on {} threads in {wall:.1} s wall ({:.1} ms per run); {failed} \
+             failed",
+            values.len(),
+            mechanism.name,
+            pool.current_num_threads(),
+            1e3 * wall * pool.current_num_threads() as f64 / values.len().max(1) as f64,
+        );
+        println!("table: {}", a.out.display());
+        return Ok(());
+    }
     let rows = pool.install(|| sweep(params, model, kind, &values, a.duration, &|| bar.inc(1)));
     bar.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();

@@ -50,8 +50,35 @@ pub struct MechanismRun {
 }
 
 /// The coordinates of `mechanism` settled at rest for `settle_s` from its layout (the
-/// layout itself for 0).
+/// layout itself for 0). The last few results are remembered (a sweep settles the same
+/// mechanism once).
 pub fn settle(mechanism: &Mechanism, numerics: &NumericsParams, settle_s: f64) -> Result<Vec<f64>> {
+    type Cache = Vec<(Mechanism, NumericsParams, f64, Vec<f64>)>;
+    static CACHE: std::sync::Mutex<Cache> = std::sync::Mutex::new(Vec::new());
+    let lookup = |cache: &Cache| {
+        cache
+            .iter()
+            .find(|(m, n, s, _)| m == mechanism && n == numerics && *s == settle_s)
+            .map(|(_, _, _, q)| q.clone())
+    };
+    if let Some(q) = CACHE.lock().ok().and_then(|c| lookup(&c)) {
+        return Ok(q);
+    }
+    let q = settle_uncached(mechanism, numerics, settle_s)?;
+    if let Ok(mut cache) = CACHE.lock() {
+        if cache.len() >= 4 {
+            cache.remove(0);
+        }
+        cache.push((mechanism.clone(), numerics.clone(), settle_s, q.clone()));
+    }
+    Ok(q)
+}
+
+fn settle_uncached(
+    mechanism: &Mechanism,
+    numerics: &NumericsParams,
+    settle_s: f64,
+) -> Result<Vec<f64>> {
     let built = mechanism.build_with(&PianoExtensions)?;
     let x = built.layout_state()?;
     let nv = built.system.model().nv();

@@ -107,13 +107,33 @@ fn times_ms(run: &Value) -> Vec<f64> {
         .unwrap_or_default()
 }
 
+/// The most series panels of a mechanism description's figure (the contact forces come
+/// after them): a figure for a paper stays readable.
+const MAX_MECHANISM_PANELS: usize = 5;
+
 /// The panels that apply to the run: hammer angle, hammer speed and key depth where the run
 /// has them, and the contact forces that carry load at some time (a pendulum has neither
 /// key nor contacts).
 fn panels(run: &Value) -> Vec<Panel> {
     let t = times_ms(run);
     let mut out = Vec::new();
-    for id in ["hammer_angle_deg", "hammer_speed_m_s", "key_depth_mm"] {
+    // A mechanism description's run plots its own series (coordinates, marker speeds); the
+    // grand action's, the hammer and the key.
+    let ids: Vec<&str> = if run["summary"]["metrics"].is_array() {
+        run["series"]
+            .as_array()
+            .map(|all| {
+                all.iter()
+                    .filter_map(|s| s["id"].as_str())
+                    .filter(|id| !id.ends_with("_mj"))
+                    .take(MAX_MECHANISM_PANELS)
+                    .collect()
+            })
+            .unwrap_or_default()
+    } else {
+        vec!["hammer_angle_deg", "hammer_speed_m_s", "key_depth_mm"]
+    };
+    for id in ids {
         let Some(s) = run["series"]
             .as_array()
             .and_then(|all| all.iter().find(|s| s["id"] == id))
@@ -207,7 +227,19 @@ fn marks(run: &Value) -> Vec<Mark> {
                 .collect()
         })
         .unwrap_or_default();
+    let described = run["summary"]["metrics"].is_array();
     for e in run["listed_events"].as_array().into_iter().flatten() {
+        if described {
+            // A description's named events, each under its own name.
+            if let (Some(name), Some(t)) = (e["name"].as_str(), e["time_s"].as_f64()) {
+                out.push(Mark {
+                    t: t * 1e3,
+                    label: name.replace('_', " "),
+                    color: RGBColor(52, 73, 94),
+                });
+            }
+            continue;
+        }
         let (label, color) = match e["name"].as_str() {
             Some("let_off") => ("let-off", RGBColor(22, 160, 133)),
             Some("key_bottom") => ("key bottom", RGBColor(211, 84, 0)),

@@ -194,3 +194,95 @@ pub fn csv(kind: SweepKind, rows: &[SweepRow]) -> String {
     }
     out
 }
+
+/// One run of a sweep of a mechanism description.
+#[derive(Clone, Debug)]
+pub struct MechanismSweepRow {
+    /// The swept force (N).
+    pub value: f64,
+    /// The description's metrics and the first time of each named event, or why the run
+    /// failed.
+    pub run: std::result::Result<(Vec<mbs_mechanism::MetricValue>, Vec<Option<f64>>), String>,
+}
+
+/// Runs `mechanism` driven by a constant force at every value of `values` (N) on its first
+/// force input, in parallel, `duration_s` each, settled once ([`crate::mechanism_run`]).
+pub fn sweep_mechanism(
+    mechanism: &mbs_mechanism::Mechanism,
+    params: &ActionParams,
+    values: &[f64],
+    duration_s: f64,
+    progress: &(dyn Fn() + Sync),
+) -> Vec<MechanismSweepRow> {
+    values
+        .par_iter()
+        .map(|&value| {
+            let run = crate::mechanism_run::simulate_mechanism(
+                mechanism,
+                &SweepKind::Force.input(value),
+                &params.numerics,
+                crate::mechanism_run::DEFAULT_SETTLE_S,
+                duration_s,
+                1e-3,
+                &mut |_| {},
+            )
+            .map(|run| {
+                let first = mechanism
+                    .events
+                    .iter()
+                    .map(|e| {
+                        run.events
+                            .iter()
+                            .find(|o| o.name == e.name)
+                            .map(|o| o.time_s)
+                    })
+                    .collect();
+                (run.metrics, first)
+            })
+            .map_err(|e| e.to_string());
+            progress();
+            MechanismSweepRow { value, run }
+        })
+        .collect()
+}
+
+/// The rows of a mechanism sweep as CSV: `touch,value,unit`, then every metric (its unit
+/// in the header) and the first time of every named event (`<event>_s`), then `error`;
+/// empty where a thing did not happen.
+pub fn mechanism_csv(mechanism: &mbs_mechanism::Mechanism, rows: &[MechanismSweepRow]) -> String {
+    let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x}"));
+    let clean = |s: &str| -> String {
+        s.chars()
+            .map(|c| if c == ',' || c == '\n' { ';' } else { c })
+            .collect()
+    };
+    let mut out = String::from("touch,value,unit");
+    for m in &mechanism.metrics {
+        let _ = write!(out, ",{} ({})", clean(&m.name), clean(&m.unit));
+    }
+    for e in &mechanism.events {
+        let _ = write!(out, ",{}_s", clean(&e.name));
+    }
+    out.push_str(",error\n");
+    for row in rows {
+        let _ = write!(out, "force,{},N", row.value);
+        match &row.run {
+            Ok((metrics, first)) => {
+                for m in metrics {
+                    let _ = write!(out, ",{}", opt(m.value));
+                }
+                for t in first {
+                    let _ = write!(out, ",{}", opt(*t));
+                }
+                out.push_str(",\n");
+            }
+            Err(e) => {
+                for _ in 0..mechanism.metrics.len() + mechanism.events.len() {
+                    out.push(',');
+                }
+                let _ = writeln!(out, ",{}", clean(e));
+            }
+        }
+    }
+    out
+}

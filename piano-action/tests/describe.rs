@@ -234,6 +234,55 @@ fn a_scenario_runs_a_description_file_like_the_built_in_model() {
     assert!(svg.contains("id=\"body-hammer\"") && svg.contains("id=\"active-hammer_string\""));
     let html = std::fs::read_to_string(a.join("report.html")).unwrap();
     assert!(html.contains("hammer speed at the strike"));
+    // The figure plots the description's own series.
+    let (ok, _, err) = piano(&["plot", a.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let figure = std::fs::read_to_string(a.join("figure.svg")).unwrap();
+    assert!(figure.contains("Hammer angle (deg)") && figure.contains("Jack angle (deg)"));
+    // A sweep of the description: the metrics per force, the hammer faster when pushed
+    // harder.
+    let table = dir.join("sweep.csv");
+    let (ok, _, err) = piano(&[
+        "sweep",
+        "--mechanism",
+        grand_file.to_str().unwrap(),
+        "--touch",
+        "force",
+        "--from",
+        "4",
+        "--to",
+        "20",
+        "--runs",
+        "3",
+        "--duration",
+        "0.08",
+        "--out",
+        table.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(&table).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "hammer speed at the strike (m/s)")
+        .unwrap();
+    let speeds: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(speeds.len(), 3);
+    assert!(speeds[0] < speeds[1] && speeds[1] < speeds[2], "{speeds:?}");
+    let (ok, _, err) = piano(&[
+        "sweep",
+        "--mechanism",
+        grand_file.to_str().unwrap(),
+        "--touch",
+        "struck",
+        "--out",
+        dir.join("no.csv").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("--touch force"), "{err}");
     // The report replays the run from its files: it reads again after the description
     // file is gone.
     std::fs::remove_file(&grand_file).unwrap();
