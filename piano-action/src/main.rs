@@ -327,21 +327,10 @@ fn simulate_scenario(
                 "option --wav: only the grand models sound their string; drop --wav".into(),
             );
         }
-        let input = scenario.input.to_input().map_err(|e| e.to_string())?;
-        let settle_s = scenario
-            .settle_s
-            .unwrap_or(piano_action::mechanism_run::DEFAULT_SETTLE_S);
         let mut progress = Progress::new(scenario.duration_s);
-        let run = piano_action::mechanism_run::simulate_mechanism(
-            mechanism,
-            &input,
-            &params.numerics,
-            settle_s,
-            scenario.duration_s,
-            scenario.output_step_s,
-            &mut |t| progress.update(t),
-        )
-        .map_err(|e| format!("{}: {e}", path.display()));
+        let run = scenario
+            .run_mechanism(params, &mut |t| progress.update(t))
+            .map_err(|e| format!("{}: {e}", path.display()));
         progress.finish();
         let run = run?;
         prepare_run_dir(out, force).map_err(|e| e.to_string())?;

@@ -573,6 +573,53 @@ impl Scenario {
         Ok(scenario)
     }
 
+    /// A scenario running `mechanism` (recorded as read from the file `file`) driven by a
+    /// force, checked: what a program that builds its own description runs.
+    pub fn for_mechanism(
+        file: &str,
+        mechanism: mbs_mechanism::Mechanism,
+        force: ForceSpec,
+        duration_s: f64,
+        output_step_s: f64,
+    ) -> Result<Self> {
+        mechanism.validate()?;
+        let scenario = Scenario {
+            model: String::new(),
+            mechanism: Some(file.to_string()),
+            settle_s: None,
+            duration_s,
+            output_step_s,
+            input: InputSpec::Force(force),
+            loaded_mechanism: Some(mechanism),
+        };
+        scenario.check()?;
+        Ok(scenario)
+    }
+
+    /// Runs a scenario with a mechanism description (see [`crate::mechanism_run`]).
+    pub fn run_mechanism(
+        &self,
+        params: &ActionParams,
+        progress: &mut dyn FnMut(f64),
+    ) -> Result<crate::mechanism_run::MechanismRun> {
+        let mechanism = self.loaded_mechanism.as_ref().ok_or_else(|| {
+            PianoError::scenario(
+                "mechanism",
+                "this scenario has no mechanism description loaded (Scenario::load reads it)",
+            )
+        })?;
+        crate::mechanism_run::simulate_mechanism(
+            mechanism,
+            &self.input.to_input()?,
+            &params.numerics,
+            self.settle_s
+                .unwrap_or(crate::mechanism_run::DEFAULT_SETTLE_S),
+            self.duration_s,
+            self.output_step_s,
+            progress,
+        )
+    }
+
     /// The model kind named by `model`.
     pub fn model_kind(&self) -> Result<ModelKind> {
         if self.model.is_empty() && self.mechanism.is_some() {
