@@ -2,6 +2,9 @@
 //! playwright-core): no console error, no network request, Play advances the clock (less at a
 //! slower speed) and moves the hammer, the scrubber, `#t=` and plot clicks seek, the string
 //! arrow shows at string contact, and no two labels on the 2D view overlap or leave it.
+//! Then the report of mechanism descriptions that are not the grand action
+//! (tests/browser/mechanism.test.mjs): the keyboard glockenspiel of
+//! `examples/mechanisms/`, its key moving, its strike pressed and drawn in 2D and 3D.
 //!
 //! Needs Node.js, Chromium (Debian's `chromium`) and `npm ci --prefix
 //! piano-action/tests/browser`, which `.ci/run` installs. This test has its own `main`
@@ -108,7 +111,7 @@ fn run() -> Outcome {
             Outcome::Skipped(why)
         };
     }
-    match checks(&here, &chromium) {
+    match checks(&here, &chromium).and_then(|()| mechanism_checks(&here, &chromium)) {
         Ok(()) => Outcome::Passed,
         Err(e) => Outcome::Failed(e),
     }
@@ -154,6 +157,79 @@ fn checks(here: &std::path::Path, chromium: &str) -> Result<(), String> {
     }
     if !shots.join("02-string-contact.png").exists() {
         return Err("no screenshot 02-string-contact.png".into());
+    }
+    Ok(())
+}
+
+/// The report of a mechanism description's run in the browser: each description of
+/// `examples/mechanisms/` with the body that must move and the contact pressed at its
+/// named event.
+fn mechanism_checks(here: &std::path::Path, chromium: &str) -> Result<(), String> {
+    let examples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/mechanisms");
+    for (file, body, contact, event, force_n) in
+        [("glockenspiel.toml", "key", "head_bar", "strike", 6.0)]
+    {
+        let mechanism = piano_action::mechanism::Mechanism::load(&examples.join(file))
+            .map_err(|e| e.to_string())?;
+        let scenario = Scenario::for_mechanism(
+            file,
+            mechanism,
+            piano_action::scenario::ForceSpec {
+                force_n: Some(force_n),
+                ramp_s: None,
+                release_s: None,
+                points: None,
+            },
+            0.1,
+            5e-4,
+        )
+        .map_err(|e| e.to_string())?;
+        let params = ActionParams::reference();
+        let run = scenario
+            .run_mechanism(&params, &mut |_| {})
+            .map_err(|e| e.to_string())?;
+        let time = run
+            .events
+            .iter()
+            .find(|e| e.name == event)
+            .map(|e| e.time_s)
+            .ok_or_else(|| format!("{file}: no {event}"))?;
+        let root = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("browser-mechanism");
+        let dir = root.join(file.trim_end_matches(".toml"));
+        piano_action::scenario::prepare_run_dir(&dir, true).map_err(|e| e.to_string())?;
+        piano_action::mechanism_run::write_mechanism_run_dir(
+            &dir,
+            &scenario,
+            &params.numerics,
+            &run,
+        )
+        .map_err(|e| e.to_string())?;
+        let report = dir.join("report.html");
+        write_report(std::slice::from_ref(&dir), &report, true).map_err(|e| e.to_string())?;
+        // Seek a little into the contact, where it is surely pressed.
+        let shots = dir.join("screenshots");
+        let out = Command::new("node")
+            .current_dir(here)
+            .arg("mechanism.test.mjs")
+            .arg(&report)
+            .arg(&shots)
+            .arg(body)
+            .arg((time + 2e-4).to_string())
+            .arg(contact)
+            .arg(event)
+            .env("CHROMIUM", chromium)
+            .output()
+            .map_err(|e| format!("cannot run node: {e}"))?;
+        let text = String::from_utf8_lossy(&out.stdout);
+        println!("    {file}:");
+        for line in text.lines() {
+            println!("    {line}");
+        }
+        println!("    screenshots in {}", shots.display());
+        if !out.status.success() {
+            let errors = String::from_utf8_lossy(&out.stderr);
+            return Err(format!("{file}: browser checks failed:\n{text}\n{errors}"));
+        }
     }
     Ok(())
 }

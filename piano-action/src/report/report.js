@@ -905,6 +905,8 @@
     labels: (k) => (views[k || 0].labels || []).map((l) => ({ text: l.text, kind: l.kind, box: l.box.slice() })),
     canvasSize: (k) => [views[k || 0].canvas.width, views[k || 0].canvas.height],
     plots: () => plots.map((p) => p.def.id),
+    // Where a body (a frame of the scene) is carried now: [angle rad, x mm, y mm].
+    carry: (frame, k) => { const r = RUNS[k || 0]; const [i, u] = locate(r, state.t); return carryAt(r, frame, i, u); },
   };
 
   draw();
