@@ -8,9 +8,43 @@
 //! ([`Mechanism::validate`], every error naming its field, and its file and line when read
 //! from one) and built into an [`mbs_core::System`] ([`Mechanism::build`]).
 //!
-//! This crate sits above `mbs-core` (bodies, joints, force elements) and `mbs-contact`
-//! (shapes, laws, strings), which a description needs both of; neither of them knows the
-//! other's file formats, and the piano action (or any striking mechanism) sits above it.
+//! This crate sits above `mbs-core` (bodies, joints, force elements), `mbs-contact`
+//! (shapes, laws, strings) and `mbs-integrators` (to read events and metrics from a
+//! solution): a description needs all of them, and none of them should know a file format
+//! of another. The piano action, and any striking mechanism, sits above it.
+//!
+//! # Build your own mechanism
+//!
+//! 1. **Bodies and joints.** List the moving bodies, each with the joint that carries it
+//!    (`[[bodies]]`, parents before children). A body's frame is its joint's frame: put
+//!    the joint at the pivot (`joint.at`, in the parent's frame; the world's for a body on
+//!    the ground) and give the centre of mass, the outline, the contact shapes and every
+//!    point in that frame. Mass in kg, inertia about the centre of mass in kg·m².
+//!    `limits` are stiff one-sided stops; `friction` is the pivot's regularised Coulomb
+//!    friction. A tree only: close a loop (a four-bar, a jack in a notch) with a contact.
+//! 2. **Springs.** `[[torsion_springs]]` on a joint (with a preload, as a pre-tensioned
+//!    spring at its stop), `[[point_springs]]` between two points, `[[cords]]` that only
+//!    pull (a tape: slack below its length).
+//! 3. **Contacts.** `[[contacts]]` with a shape list on each side (`circle`, `segment` —
+//!    its outward side on the left of `a → b` —, `arc` convex or concave, `profile`) and a
+//!    law: a material preset (`law = { material = "action_felt" }`, see
+//!    [`material_names`]) or explicit parameters (`felt`, `hertz`, `kelvin_voigt`,
+//!    `hunt_crossley`, `stulov`), and friction. `[[strings]]` strike a modal string.
+//! 4. **Inputs, markers, events, metrics.** Where a force or a prescribed motion drives it
+//!    (`[[inputs]]`), named points (`[[markers]]`), named events (a contact's `onset` or
+//!    `release`, a `coordinate` crossing a `value`) and metrics read at an event's first
+//!    occurrence (a marker's `speed`, `x`, `y`, velocity, or the `time`).
+//! 5. **Check, build, run.** [`Mechanism::load`] reads and checks a file;
+//!    [`Mechanism::build`] gives a [`Built`] system; [`Built::drive_force`] applies an
+//!    input; integrate with `mbs-integrators`; [`Mechanism::events_in`] and
+//!    [`Mechanism::metrics_in`] read the solution. `piano simulate` runs a scenario with
+//!    `mechanism = "FILE"` and writes a run directory, drawings and the report from it.
+//!
+//! Tag every number with where it comes from in the `note` fields (and in comments of a
+//! TOML file): \[V\] read in a source, \[S\] secondhand, \[M\] recalled or judged, \[D\]
+//! derived. The repository's `examples/mechanisms/glockenspiel.toml` is a complete small
+//! description written by hand; `examples/upright` writes an upright piano action through
+//! the API; `piano describe` writes the grand action.
 //!
 //! ```
 //! use mbs_mechanism::Mechanism;
