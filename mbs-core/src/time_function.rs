@@ -210,3 +210,116 @@ mod tests {
         assert!(SmoothMove::new(1.0, 0.0, 1.0, 1.0).is_err());
     }
 }
+
+/// A piecewise-linear motion whose corners are rounded by parabolic blends (C¹, finite
+/// acceleration), constant before the first and after the last point.
+#[derive(Clone, Debug)]
+pub struct BlendedLinear {
+    t: Vec<f64>,
+    q: Vec<f64>,
+    /// Half-width of the blend at each point (s).
+    tau: Vec<f64>,
+}
+
+impl BlendedLinear {
+    /// Builds the motion through `(t, q)` points, each corner rounded over `2 τ` with
+    /// `τ = min(max_blend_s, a quarter of each side)`. Refused: no points, values that are
+    /// not finite, times that do not increase, a negative or non-finite blend.
+    pub fn new(points: &[(f64, f64)], max_blend_s: f64) -> Result<Self> {
+        if points.is_empty() {
+            return Err(CoreError::InvalidParameter {
+                item: "blended linear motion.points".into(),
+                message: "a motion needs at least one point".into(),
+            });
+        }
+        if !(max_blend_s.is_finite() && max_blend_s >= 0.0) {
+            return Err(CoreError::InvalidParameter {
+                item: "blended linear motion.max_blend_s".into(),
+                message: format!("must be a non-negative time, got {max_blend_s}"),
+            });
+        }
+        for (i, p) in points.iter().enumerate() {
+            if !(p.0.is_finite() && p.1.is_finite()) {
+                return Err(CoreError::InvalidParameter {
+                    item: format!("blended linear motion.points[{i}]"),
+                    message: format!("must be finite, got ({}, {})", p.0, p.1),
+                });
+            }
+            if i > 0 && p.0 <= points[i - 1].0 {
+                return Err(CoreError::InvalidParameter {
+                    item: format!("blended linear motion.points[{i}]"),
+                    message: format!("times must increase: {} after {}", p.0, points[i - 1].0),
+                });
+            }
+        }
+        let t: Vec<f64> = points.iter().map(|p| p.0).collect();
+        let q: Vec<f64> = points.iter().map(|p| p.1).collect();
+        let n = t.len();
+        let tau = (0..n)
+            .map(|k| {
+                let before = if k > 0 {
+                    t[k] - t[k - 1]
+                } else {
+                    f64::INFINITY
+                };
+                let after = if k + 1 < n {
+                    t[k + 1] - t[k]
+                } else {
+                    f64::INFINITY
+                };
+                max_blend_s.min(0.25 * before).min(0.25 * after)
+            })
+            .collect();
+        Ok(BlendedLinear { t, q, tau })
+    }
+
+    /// Slope of segment `i` (between points `i` and `i + 1`); 0 outside the table.
+    fn slope(&self, i: isize) -> f64 {
+        if i < 0 || i as usize + 1 >= self.t.len() {
+            0.0
+        } else {
+            let i = i as usize;
+            (self.q[i + 1] - self.q[i]) / (self.t[i + 1] - self.t[i])
+        }
+    }
+}
+
+impl Drive for BlendedLinear {
+    fn eval(&self, t: f64) -> DriveState {
+        let n = self.t.len();
+        // Inside a corner blend?
+        for k in 0..n {
+            let (tk, tau) = (self.t[k], self.tau[k]);
+            if tau > 0.0 && (t - tk).abs() < tau {
+                let (m0, m1) = (self.slope(k as isize - 1), self.slope(k as isize));
+                let s = t - tk + tau;
+                return DriveState {
+                    q: self.q[k] + m0 * (t - tk) + (m1 - m0) * s * s / (4.0 * tau),
+                    v: m0 + (m1 - m0) * s / (2.0 * tau),
+                    a: (m1 - m0) / (2.0 * tau),
+                };
+            }
+        }
+        if t <= self.t[0] {
+            return DriveState {
+                q: self.q[0],
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        if t >= self.t[n - 1] {
+            return DriveState {
+                q: self.q[n - 1],
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        let i = self.t.partition_point(|&tk| tk <= t) - 1;
+        let m = self.slope(i as isize);
+        DriveState {
+            q: self.q[i] + m * (t - self.t[i]),
+            v: m,
+            a: 0.0,
+        }
+    }
+}
