@@ -6,7 +6,11 @@
 //! and profiles on each side; a law by material preset or by parameters; friction),
 //! strikers on modal strings, inputs, markers, named events and metrics. It is checked
 //! ([`Mechanism::validate`], every error naming its field, and its file and line when read
-//! from one) and built into an [`mbs_core::System`] ([`Mechanism::build`]).
+//! from one) and built into an [`mbs_core::System`] ([`Mechanism::build`]). A description
+//! can be transformed into another (module [`transform`]): a body split in two on a sprung
+//! joint ([`Mechanism::split_body`]), a contact's side mounted on a compliant pivot
+//! ([`Mechanism::mount_compliant`]), a contact's law or friction swapped
+//! ([`Mechanism::swap_law`], [`Mechanism::swap_friction`]).
 //!
 //! This crate sits above `mbs-core` (bodies, joints, force elements) and `mbs-contact`
 //! (shapes, laws, strings), which a description needs both of; neither of them knows the
@@ -41,10 +45,12 @@ pub mod description;
 mod error;
 mod io;
 pub mod toml_lines;
+pub mod transform;
 mod validate;
 
 pub use build::{Built, Extensions, NoExtensions, normal_law, shapes};
 pub use description::*;
 pub use error::{MechanismError, Result};
 pub use io::Format;
+pub use transform::{Flex, MassProps, Side, distal_contact_name, flex_spring_name};
 pub use validate::material_names;
