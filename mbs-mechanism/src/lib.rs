@@ -6,7 +6,11 @@
 //! and profiles on each side; a law by material preset or by parameters; friction),
 //! strikers on modal strings, inputs, markers, named events and metrics. It is checked
 //! ([`Mechanism::validate`], every error naming its field, and its file and line when read
-//! from one) and built into an [`mbs_core::System`] ([`Mechanism::build`]).
+//! from one) and built into an [`mbs_core::System`] ([`Mechanism::build`]). A description
+//! can be transformed into another (module [`transform`]): a body split in two on a sprung
+//! joint ([`Mechanism::split_body`]), a contact's side mounted on a compliant pivot
+//! ([`Mechanism::mount_compliant`]), a contact's law or friction swapped
+//! ([`Mechanism::swap_law`], [`Mechanism::swap_friction`]).
 //!
 //! This crate sits above `mbs-core` (bodies, joints, force elements), `mbs-contact`
 //! (shapes, laws, strings) and `mbs-integrators` (to read events and metrics from a
@@ -76,6 +80,7 @@ mod error;
 mod evaluate;
 mod io;
 pub mod toml_lines;
+pub mod transform;
 mod validate;
 
 pub use build::{Built, Extensions, NoExtensions, normal_law, shapes};
@@ -83,4 +88,5 @@ pub use description::*;
 pub use error::{MechanismError, Result};
 pub use evaluate::{EventOccurrence, MetricValue};
 pub use io::Format;
+pub use transform::{Flex, MassProps, Side, distal_contact_name, flex_spring_name};
 pub use validate::material_names;

@@ -18,7 +18,7 @@ pub(crate) fn finite(field: &str, value: f64) -> Result<f64> {
     }
 }
 
-fn positive(field: &str, value: f64) -> Result<f64> {
+pub(crate) fn positive(field: &str, value: f64) -> Result<f64> {
     if finite(field, value)? > 0.0 {
         Ok(value)
     } else {
@@ -26,7 +26,7 @@ fn positive(field: &str, value: f64) -> Result<f64> {
     }
 }
 
-fn non_negative(field: &str, value: f64) -> Result<f64> {
+pub(crate) fn non_negative(field: &str, value: f64) -> Result<f64> {
     if finite(field, value)? >= 0.0 {
         Ok(value)
     } else {
@@ -34,7 +34,7 @@ fn non_negative(field: &str, value: f64) -> Result<f64> {
     }
 }
 
-fn point(field: &str, p: [f64; 2]) -> Result<()> {
+pub(crate) fn point(field: &str, p: [f64; 2]) -> Result<()> {
     finite(&format!("{field}[0]"), p[0])?;
     finite(&format!("{field}[1]"), p[1])?;
     Ok(())
@@ -233,7 +233,7 @@ fn side(field: &str, s: &ContactSideSpec, names: &Names<'_>) -> Result<()> {
     Ok(())
 }
 
-fn law(field: &str, l: &LawSpec) -> Result<()> {
+pub(crate) fn law(field: &str, l: &LawSpec) -> Result<()> {
     match l {
         LawSpec::Material(name) => {
             material(&format!("{field}.material"), name)?;
@@ -284,7 +284,7 @@ fn law(field: &str, l: &LawSpec) -> Result<()> {
     Ok(())
 }
 
-fn friction(field: &str, f: &ContactFrictionSpec) -> Result<()> {
+pub(crate) fn friction(field: &str, f: &ContactFrictionSpec) -> Result<()> {
     match f {
         ContactFrictionSpec::Coulomb { mu, regularization } => {
             non_negative(&format!("{field}.coulomb.mu"), *mu)?;
