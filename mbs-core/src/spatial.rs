@@ -370,8 +370,16 @@ impl Inertia {
             m: mass,
             hx: mass * com[0],
             hy: mass * com[1],
-            i_o: izz_com + mass * (com[0] * com[0] + com[1] * com[1]),
+            i_o: izz_com + Self::parallel_axis(mass, com),
         }
+    }
+
+    /// The parallel-axis term `m |c|²`: what a mass `mass` at `com` adds to the rotational
+    /// inertia about the origin over its inertia about its own centre of mass
+    /// (`I_o = I_c + m |c|²`). The one place this theorem is written.
+    #[inline]
+    pub fn parallel_axis(mass: f64, com: [f64; 2]) -> f64 {
+        mass * (com[0] * com[0] + com[1] * com[1])
     }
 
     /// Centre of mass in the frame's coordinates (the origin when the mass is zero).

@@ -72,7 +72,7 @@ impl MassProps {
 
     /// Inertia about the frame's origin (the joint): `I + m |c|²`.
     pub fn inertia_about_origin(&self) -> f64 {
-        self.inertia + self.mass * dot(self.com, self.com)
+        self.inertia + mbs_core::Inertia::parallel_axis(self.mass, self.com)
     }
 
     /// The two parts as one rigid part: masses add, the centre of mass is their
@@ -87,7 +87,7 @@ impl MassProps {
         MassProps {
             mass,
             com,
-            inertia: about_origin - mass * dot(com, com),
+            inertia: about_origin - mbs_core::Inertia::parallel_axis(mass, com),
         }
     }
 
@@ -104,7 +104,7 @@ impl MassProps {
         MassProps {
             mass,
             com,
-            inertia: about_origin - mass * dot(com, com),
+            inertia: about_origin - mbs_core::Inertia::parallel_axis(mass, com),
         }
     }
 }
@@ -380,7 +380,7 @@ fn remainder(field: &str, body: &Body, part: &MassProps) -> Result<MassProps> {
                 rest.mass,
                 rest.com[0],
                 rest.com[1],
-                rest.mass * dot(rest.com, rest.com),
+                mbs_core::Inertia::parallel_axis(rest.mass, rest.com),
                 rest.inertia
             ),
         ));

@@ -27,7 +27,7 @@
 
 use std::collections::BTreeMap;
 
-use mbs_core::{ForceElement, Model};
+use mbs_core::{ForceElement, Inertia, Model};
 use mbs_mechanism::{
     Body, BodyPoint, ContactFrictionSpec, ContactPair, ContactPhase, ContactSideSpec, EventSpec,
     Extension, Extensions, Input, InputKind, Joint, JointType, LawSpec, Limits, LoadSpec, Marker,
@@ -137,7 +137,7 @@ pub fn grand_mechanism(
     let mut bodies = Vec::new();
     let key_com = rel(k.com_mm, k.pivot_mm);
     let key_mass = k.mass_g * 1e-3;
-    let key_i = k.inertia_pivot_kg_m2 - key_mass * (key_com[0].powi(2) + key_com[1].powi(2));
+    let key_i = k.inertia_pivot_kg_m2 - Inertia::parallel_axis(key_mass, key_com);
     bodies.push(Body {
         name: "key".into(),
         note: format!("balance pivot; {tag}"),
@@ -165,7 +165,7 @@ pub fn grand_mechanism(
     let jack_at = rel(j.pivot_mm, w.pivot_mm);
     let jack_com = rel(j.com_mm, j.pivot_mm);
     let jack_mass = j.mass_g * 1e-3;
-    let jack_i = j.inertia_pivot_kg_m2 - jack_mass * (jack_com[0].powi(2) + jack_com[1].powi(2));
+    let jack_i = j.inertia_pivot_kg_m2 - Inertia::parallel_axis(jack_mass, jack_com);
     bodies.push(Body {
         name: "jack".into(),
         note: if with_jack {
@@ -199,7 +199,7 @@ pub fn grand_mechanism(
         let at = rel(r.pivot_mm, w.pivot_mm);
         let com = rel(r.com_mm, r.pivot_mm);
         let mass = r.mass_g * 1e-3;
-        let i = r.inertia_pivot_kg_m2 - mass * (com[0].powi(2) + com[1].powi(2));
+        let i = r.inertia_pivot_kg_m2 - Inertia::parallel_axis(mass, com);
         bodies.push(Body {
             name: "repetition_lever".into(),
             note: format!("repetition lever centre on the wippen; {tag}"),

@@ -465,8 +465,7 @@ fn bodies(p: &ActionParams, r: &mut Report) {
     let (k, w, j, l, h) = (&p.key, &p.wippen, &p.jack, &p.repetition_lever, &p.hammer);
     let s = Shapes::new(p);
     let from_pivot = |m_g: f64, com: V, pivot: V| {
-        let d = scale(sub(com, pivot), 1e-3);
-        m_g * 1e-3 * dot(d, d)
+        mbs_core::Inertia::parallel_axis(m_g * 1e-3, scale(sub(com, pivot), 1e-3))
     };
     let face_ends = |f: Face| [(f.a, 0.0), (f.b, 0.0)];
     let rest = Pose::default();
