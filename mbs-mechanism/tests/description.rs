@@ -122,8 +122,11 @@ fn builds_every_part_in_its_place() {
     assert_eq!(model.nv(), 2);
     assert_eq!(model.coordinate_id("lever").unwrap(), 0);
     assert_eq!(model.coordinate_id("weight").unwrap(), 1);
-    // Springs, the cord, the stop, friction, the load and the contact.
-    assert_eq!(built.system.elements().len(), 7);
+    // Springs, the cord, the stop, friction, the load, the contact, and the switching
+    // function of the coordinate event.
+    assert_eq!(built.system.elements().len(), 8);
+    assert_eq!(built.watches.len(), 1);
+    assert!(built.watches.contains_key("half way"));
     assert_eq!(built.contacts.len(), 1);
     for name in [
         "return spring",
