@@ -101,6 +101,44 @@ impl ForceElement for CoordinateWatch {
     }
 }
 
+/// A contact of a built mechanism, kept with its type so that drawings and outputs reach
+/// its shapes and outputs directly (no downcast through the system's elements).
+#[derive(Clone, Debug)]
+pub enum ContactHandle {
+    /// Two shapes and a law.
+    Plain(Arc<Contact>),
+    /// A striker on a modal string.
+    String(Arc<StringContact>),
+}
+
+impl ContactHandle {
+    /// The bodies and shapes (in the bodies' frames) of the two sides (the string at rest
+    /// for a string).
+    pub fn sides(&self) -> [(mbs_core::BodyId, &[mbs_contact::Shape]); 2] {
+        match self {
+            ContactHandle::Plain(c) => c.sides(),
+            ContactHandle::String(s) => s.sides(),
+        }
+    }
+
+    /// Gap, forces, point and normal at the state in `ctx` (the context of the contact's
+    /// element, see [`System::element_context`]).
+    pub fn output(&self, ctx: &mbs_core::ForceContext<'_>) -> mbs_contact::ContactOutput {
+        match self {
+            ContactHandle::Plain(c) => c.output(ctx),
+            ContactHandle::String(s) => s.output(ctx),
+        }
+    }
+
+    /// The string, for a striker on one.
+    pub fn string(&self) -> Option<&StringContact> {
+        match self {
+            ContactHandle::Plain(_) => None,
+            ContactHandle::String(s) => Some(s),
+        }
+    }
+}
+
 /// A built mechanism: the system and where its named parts are.
 pub struct Built {
     /// The system to integrate.
@@ -110,6 +148,8 @@ pub struct Built {
     pub elements: BTreeMap<String, usize>,
     /// Element index of each contact and string, by name.
     pub contacts: BTreeMap<String, usize>,
+    /// Each contact and string with its type, by name.
+    pub contact_handles: BTreeMap<String, ContactHandle>,
     /// Element index of the switching function of each coordinate event, by event name.
     pub watches: BTreeMap<String, usize>,
 }
@@ -346,6 +386,7 @@ impl Mechanism {
         let mut system = System::new(model.clone());
         let mut elements = BTreeMap::new();
         let mut contacts = BTreeMap::new();
+        let mut contact_handles = BTreeMap::new();
 
         for (i, s) in self.torsion_springs.iter().enumerate() {
             let f = format!("torsion_springs[{i}]");
@@ -466,9 +507,11 @@ impl Mechanism {
                     e = e.with_friction(law);
                 }
             }
-            let index = system.add_element(e).map_err(core(&f))?;
+            let e = Arc::new(e);
+            let index = system.add_shared_element(e.clone()).map_err(core(&f))?;
             elements.insert(c.name.clone(), index);
             contacts.insert(c.name.clone(), index);
+            contact_handles.insert(c.name.clone(), ContactHandle::Plain(e));
         }
         for (i, s) in self.strings.iter().enumerate() {
             let f = format!("strings[{i}]");
@@ -481,9 +524,11 @@ impl Mechanism {
                 normal_law(&format!("{f}.law"), &s.law)?,
             )
             .map_err(contact_err(&f))?;
-            let index = system.add_element(e).map_err(core(&f))?;
+            let e = Arc::new(e);
+            let index = system.add_shared_element(e.clone()).map_err(core(&f))?;
             elements.insert(s.name.clone(), index);
             contacts.insert(s.name.clone(), index);
+            contact_handles.insert(s.name.clone(), ContactHandle::String(e));
         }
         // Coordinate events last: they exert nothing, and the integrator locates them.
         let mut watches = BTreeMap::new();
@@ -507,6 +552,7 @@ impl Mechanism {
             system,
             elements,
             contacts,
+            contact_handles,
             watches,
         })
     }

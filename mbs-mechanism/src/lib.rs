@@ -83,7 +83,7 @@ pub mod toml_lines;
 pub mod transform;
 mod validate;
 
-pub use build::{Built, Extensions, NoExtensions, normal_law, shapes};
+pub use build::{Built, ContactHandle, Extensions, NoExtensions, normal_law, shapes};
 pub use description::*;
 pub use error::{MechanismError, Result};
 pub use evaluate::{EventOccurrence, MetricValue};

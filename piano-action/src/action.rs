@@ -23,10 +23,11 @@
 
 use std::collections::BTreeMap;
 
-use mbs_contact::{Contact, ContactOutput, Shape, StringContact};
+use mbs_contact::StringContact;
 use mbs_core::elements::{AppliedLoad, Attachment, LoadFrame};
 use mbs_core::{System, TimeFunction};
 use mbs_integrators::{EventAction, Method, MultibodyOde, Options, Solution, solve_observed};
+use mbs_mechanism::ContactHandle;
 
 use crate::error::Result;
 use crate::params::{ActionParams, ContactParams};
@@ -66,6 +67,8 @@ pub struct Action {
     pub system: System,
     /// Element index of each contact, by name (`"capstan_heel"`, `"hammer_string"`, ...).
     pub contacts: BTreeMap<String, usize>,
+    /// Each contact with its type (shapes and outputs without a downcast), by name.
+    pub contact_handles: BTreeMap<String, ContactHandle>,
     /// The presser over the key front (a weight or a finger), if it was built with one.
     pub presser: Option<Presser>,
 }
@@ -155,6 +158,7 @@ impl Action {
             params: params.clone(),
             system: built.system,
             contacts: built.contacts,
+            contact_handles: built.contact_handles,
             presser,
         })
     }
@@ -273,15 +277,13 @@ impl Action {
         let e = *self.contacts.get(name).ok_or_else(unknown)?;
         let mut ws = self.system.workspace();
         let ctx = self.system.element_context(&mut ws, t, x, e)?;
-        let element = self.system.elements().nth(e).ok_or_else(unknown)?;
-        let contact = ContactElement::of(element).ok_or_else(unknown)?;
+        let contact = self.contact_handles.get(name).ok_or_else(unknown)?;
         Ok(contact.output(&ctx))
     }
 
     /// The string the hammer strikes (its element in the system), if the action has one.
     pub fn string_contact(&self) -> Option<&StringContact> {
-        let e = *self.contacts.get("hammer_string")?;
-        self.system.elements().nth(e).and_then(StringContact::of)
+        self.contact_handles.get("hammer_string")?.string()
     }
 
     /// Where the string's internal states lie in the state vector (its modal amplitudes
@@ -373,39 +375,4 @@ pub fn integrate_system(
         progress,
     )
     .map_err(|e| crate::PianoError::Simulation(e.to_string()))
-}
-
-/// A contact element of the action: a plain [`Contact`] or the hammer on the string
-/// ([`StringContact`]), seen through what drawings and outputs need of both.
-#[derive(Clone, Copy, Debug)]
-pub enum ContactElement<'a> {
-    /// Two shapes and a law.
-    Plain(&'a Contact),
-    /// The hammer crown on the modal string.
-    String(&'a StringContact),
-}
-
-impl<'a> ContactElement<'a> {
-    /// The contact behind a force element, if it is one.
-    pub fn of(element: &'a dyn mbs_core::ForceElement) -> Option<Self> {
-        Contact::of(element)
-            .map(ContactElement::Plain)
-            .or_else(|| StringContact::of(element).map(ContactElement::String))
-    }
-
-    /// The bodies and shapes of the two sides (the string at rest for the string).
-    pub fn sides(&self) -> [(mbs_core::BodyId, &'a [Shape]); 2] {
-        match self {
-            ContactElement::Plain(c) => c.sides(),
-            ContactElement::String(s) => s.sides(),
-        }
-    }
-
-    /// Gap, forces, point and normal at the state in `ctx`.
-    pub fn output(&self, ctx: &mbs_core::ForceContext<'_>) -> ContactOutput {
-        match self {
-            ContactElement::Plain(c) => c.output(ctx),
-            ContactElement::String(s) => s.output(ctx),
-        }
-    }
 }

@@ -43,9 +43,10 @@ pub mod toml_lines;
 pub mod touchweight;
 pub mod validate;
 
-pub use action::{Action, ContactElement, ModelKind, Presser, integrate_system};
+pub use action::{Action, ModelKind, Presser, integrate_system};
 pub use drawing::action_svg;
 pub use error::{InputError, InputKind, PianoError, Result};
+pub use mbs_mechanism::ContactHandle;
 pub use params::ActionParams;
 pub use simulate::{
     BLOW_PULSE_GAP_S, Finger, Input, PianoEvent, Run, Strike, TouchStyle, simulate,

@@ -21,7 +21,7 @@ use mbs_mechanism::{
 };
 use serde_json::{Value, json};
 
-use crate::action::{ContactElement, integrate_system};
+use crate::action::integrate_system;
 use crate::describe::PianoExtensions;
 use crate::error::{PianoError, Result};
 use crate::params::NumericsParams;
@@ -274,9 +274,9 @@ pub fn write_mechanism_run_dir(
     for i in 0..sol.len() {
         let (t, x) = (sol.t[i], sol.state(i));
         let _ = write!(csv, "{t}");
-        for &e in run.built.contacts.values() {
+        for (name, &e) in &run.built.contacts {
             let ctx = system.element_context(&mut ws, t, x, e)?;
-            match system.elements().nth(e).and_then(ContactElement::of) {
+            match run.built.contact_handles.get(name) {
                 Some(c) => {
                     let o = c.output(&ctx);
                     let f = if o.active {

@@ -23,9 +23,9 @@ use std::fmt::Write;
 
 use mbs_contact::Shape;
 use mbs_core::{CoreError, Data, Transform, frame_pose, update_poses};
-use mbs_mechanism::{Built, Mechanism, OutlinePart};
+use mbs_mechanism::{Built, ContactHandle, Mechanism, OutlinePart};
 
-use crate::action::{Action, ContactElement, PRESSER_PAD_RADIUS_MM, Presser};
+use crate::action::{Action, PRESSER_PAD_RADIUS_MM, Presser};
 use crate::error::Result;
 use crate::params::ActionParams;
 

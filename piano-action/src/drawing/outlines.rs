@@ -101,7 +101,14 @@ pub fn mechanism_svg(
     }
     let frames = mechanism_frames(mechanism);
     let (rest, carry) = rest_and_carry_of(&built.system, &frames, t, x)?;
-    let contacts = contact_views(&built.system, &built.contacts, t, x, |n| n)?;
+    let contacts = contact_views(
+        &built.system,
+        &built.contacts,
+        &built.contact_handles,
+        t,
+        x,
+        |n| n,
+    )?;
     let parts = mechanism_parts(mechanism, &rest);
     let legend = format!("{}: contact shapes; white dots: pivots", mechanism.name);
     Ok(render(&parts, &carry, &contacts, &legend, title))
@@ -140,7 +147,7 @@ pub fn mechanism_scene(mechanism: &Mechanism, built: &Built) -> Result<serde_jso
     Ok(serde_json::json!({
         "frames": frames,
         "parts": parts_json,
-        "contacts": rest_contacts_json(&built.system, &built.contacts)?,
+        "contacts": rest_contacts_json(&built.system, &built.contacts, &built.contact_handles)?,
     }))
 }
 

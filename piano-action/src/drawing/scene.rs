@@ -68,7 +68,7 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
     Ok(serde_json::json!({
         "frames": drawn_frames(action),
         "parts": parts,
-        "contacts": rest_contacts_json(&action.system, &action.contacts)?,
+        "contacts": rest_contacts_json(&action.system, &action.contacts, &action.contact_handles)?,
     }))
 }
 
@@ -76,13 +76,14 @@ pub fn scene(action: &Action) -> Result<serde_json::Value> {
 pub(super) fn rest_contacts_json(
     system: &mbs_core::System,
     contacts_by_name: &BTreeMap<String, usize>,
+    handles: &BTreeMap<String, ContactHandle>,
 ) -> Result<Vec<serde_json::Value>> {
     let model = system.model();
     let mut contacts = Vec::new();
     let mut rest_data = Data::new(model);
     update_poses(model, &mut rest_data, &vec![0.0; model.nv()])?;
-    for (name, &e) in contacts_by_name {
-        let Some(c) = system.elements().nth(e).and_then(ContactElement::of) else {
+    for name in contacts_by_name.keys() {
+        let Some(c) = handles.get(name) else {
             continue;
         };
         let mut sides = Vec::new();

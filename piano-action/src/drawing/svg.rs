@@ -217,13 +217,18 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
         .into());
     }
     let (rest, carry) = rest_and_carry(action, t, x)?;
-    let contacts = contact_views(&action.system, &action.contacts, t, x, |name| {
-        match (name, action.presser) {
+    let contacts = contact_views(
+        &action.system,
+        &action.contacts,
+        &action.contact_handles,
+        t,
+        x,
+        |name| match (name, action.presser) {
             ("presser_key", Some(p)) if p.carried => "finger_key",
             ("presser_key", Some(_)) => "mass_key",
             _ => name,
-        }
-    })?;
+        },
+    )?;
 
     let parts = build_parts(action, &rest);
     let legend = format!(
@@ -238,6 +243,7 @@ pub fn action_svg(action: &Action, t: f64, x: &[f64], title: &str) -> Result<Str
 pub(super) fn contact_views<'a>(
     system: &mbs_core::System,
     contacts: &'a BTreeMap<String, usize>,
+    handles: &BTreeMap<String, ContactHandle>,
     t: f64,
     x: &[f64],
     label: impl Fn(&'a str) -> &'a str,
@@ -254,7 +260,7 @@ pub(super) fn contact_views<'a>(
         if element.switch_count() > 0 {
             element.switching_functions(&ctx, &mut gap);
         }
-        let (shapes, point) = match ContactElement::of(element) {
+        let (shapes, point) = match handles.get(name) {
             Some(c) => {
                 let shapes = c
                     .sides()
