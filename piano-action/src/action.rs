@@ -71,6 +71,8 @@ pub struct Action {
     pub contact_handles: BTreeMap<String, ContactHandle>,
     /// The presser over the key front (a weight or a finger), if it was built with one.
     pub presser: Option<Presser>,
+    /// The description the system was built from (a run directory keeps it).
+    pub mechanism: mbs_mechanism::Mechanism,
 }
 
 /// Radius of a [`Presser`]'s round pad (mm): its contact with the key top.
@@ -160,6 +162,7 @@ impl Action {
             contacts: built.contacts,
             contact_handles: built.contact_handles,
             presser,
+            mechanism: mechanism.clone(),
         })
     }
 

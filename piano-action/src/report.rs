@@ -185,7 +185,7 @@ pub(crate) fn series_to_json(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Value> 
 /// The report data of one run directory (see the module docs).
 pub fn run_data(dir: &Path) -> Result<Value> {
     let run = read_json(dir, "run.json")?;
-    if run.get("mechanism").is_some() {
+    if run["scenario"].get("mechanism").is_some() {
         return crate::mechanism_run::report_data(dir, &run);
     }
     let scenario: Scenario = serde_json::from_value(run["scenario"].clone())
@@ -199,6 +199,10 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         return pendulum_data(dir, &params, release_angle_deg);
     }
     let kind: ModelKind = scenario.model_kind()?;
+    if dir.join(SCENE_JSON).exists() {
+        return grand_data_from_files(dir, &scenario, kind);
+    }
+    // A run directory written before the replay files: rebuild the action and settle it.
     let Prepared {
         action,
         x0,
@@ -409,6 +413,247 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
         "summary": read_json(dir, "summary.json")?,
         "zoom": zoom,
+        "measured": measured,
+    }))
+}
+
+/// The run-directory file with the drawing's scene and the zoom presets (written by
+/// `piano simulate`, so the report replays a run without rebuilding the action).
+pub const SCENE_JSON: &str = "scene.json";
+
+/// The grand series of the report and `series.csv`: id and label.
+const GRAND_SERIES: [(&str, &str); 6] = [
+    ("hammer_angle_deg", "hammer angle (°)"),
+    ("hammer_speed_m_s", "hammer speed at the strike point (m/s)"),
+    ("key_depth_mm", "key-front depth below rest (mm)"),
+    ("kinetic_mj", "kinetic energy (mJ)"),
+    ("gravity_mj", "gravitational energy from rest (mJ)"),
+    ("key_drive_force_n", "hand force at the key front (N)"),
+];
+
+/// Writes what the report of a grand run reads besides `trajectory.csv` and `contacts.csv`
+/// (which must be written): `poses.csv` (every drawn frame's motion from its rest place),
+/// `series.csv` (hammer angle and speed, key depth, energies, the hand's force under a key
+/// motion) and [`SCENE_JSON`] (the drawing's parts and contact shapes at rest, the zoom
+/// presets). The report then needs neither the parameters' action nor a settle.
+pub(crate) fn write_replay_files(
+    dir: &Path,
+    prepared: &Prepared,
+    run: &crate::simulate::Run,
+) -> Result<()> {
+    use std::fmt::Write as _;
+    let action = &prepared.action;
+    let params = &action.params;
+    let sol = &run.solution;
+    let model = action.system.model();
+    let nv = model.nv();
+    let key = model.coordinate_id("key")?;
+    let hammer = model.coordinate_id("hammer")?;
+    let strike_radius_m = {
+        let s = params.hammer.strike_body_mm;
+        s[0].hypot(s[1]) * 1e-3
+    };
+    let with_drive = run.key_drive_force_n.len() == sol.len();
+    let mut poses = String::from("time_s");
+    for (f, _) in crate::drawing::carry(action, 0.0, &prepared.x0)? {
+        let _ = write!(poses, ",{f}_angle_rad,{f}_x_mm,{f}_y_mm");
+    }
+    poses.push('\n');
+    let mut series = String::from("time_s");
+    for (id, _) in GRAND_SERIES.iter().take(if with_drive { 6 } else { 5 }) {
+        let _ = write!(series, ",{id}");
+    }
+    series.push('\n');
+    let mut ws = action.system.workspace();
+    let mut potential0 = None;
+    for i in 0..sol.len() {
+        let (time, x) = (sol.t[i], sol.state(i));
+        let _ = write!(poses, "{time}");
+        for (_, c) in crate::drawing::carry(action, time, x)? {
+            let _ = write!(poses, ",{},{},{}", c[0], c[1], c[2]);
+        }
+        poses.push('\n');
+        let e = action.system.energy(&mut ws, time, x)?;
+        // The elastic energy is left out: under a touch it holds the arm's work (a preload),
+        // which would swamp the action's own.
+        let p0 = *potential0.get_or_insert(e.gravity);
+        let _ = write!(
+            series,
+            "{time},{},{},{},{},{}",
+            x[hammer].to_degrees(),
+            x[nv + hammer] * strike_radius_m,
+            key_depth_mm(params, x[key]) - prepared.rest_depth_mm,
+            e.kinetic * 1e3,
+            (e.gravity - p0) * 1e3
+        );
+        if with_drive {
+            let _ = write!(series, ",{}", run.key_drive_force_n[i]);
+        }
+        series.push('\n');
+    }
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text)
+            .map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))
+    };
+    write("poses.csv", &poses)?;
+    write("series.csv", &series)?;
+    let scene = json!({
+        "scene": crate::drawing::scene(action)?,
+        "zoom": zoom_presets(action, &prepared.x0)?,
+    });
+    let text = serde_json::to_string(&scene)
+        .map_err(|e| PianoError::file(&dir.join(SCENE_JSON), format!("cannot encode: {e}")))?;
+    write(SCENE_JSON, &text)
+}
+
+/// Where millimetres matter: the contacts that set the regulation, at rest.
+fn zoom_presets(action: &crate::Action, x0: &[f64]) -> Result<Value> {
+    let mut zoom = serde_json::Map::new();
+    for (label, contact, half) in [
+        ("let-off", "let_off_button", 18.0),
+        ("jack and knuckle", "jack_knuckle", 18.0),
+        ("string", "hammer_string", 25.0),
+        ("backcheck", "backcheck", 25.0),
+        ("capstan", "capstan_heel", 18.0),
+    ] {
+        if action.contacts.contains_key(contact) {
+            // The first side's surface point (the string, the button, the jack top, the
+            // backcheck face, the capstan), not the middle of a wide gap.
+            let o = action.contact_output(contact, 0.0, x0)?;
+            let p = [
+                o.point[0] - 0.5 * o.gap * o.normal[0],
+                o.point[1] - 0.5 * o.gap * o.normal[1],
+            ];
+            zoom.insert(
+                label.into(),
+                json!({"center": [r(p[0] * 1e3, 2), r(p[1] * 1e3, 2)], "half_width": half}),
+            );
+        }
+    }
+    Ok(Value::Object(zoom))
+}
+
+/// The report data of a grand run from its files alone (see [`write_replay_files`]).
+fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Result<Value> {
+    let scene_file = read_json(dir, SCENE_JSON)?;
+    let frames = scene_file["scene"].clone();
+    let frame_names: Vec<String> = frames["frames"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(Value::as_str)
+                .map(str::to_string)
+                .collect()
+        })
+        .unwrap_or_default();
+    let (header, rows) = read_numeric_csv(dir, "poses.csv")?;
+    // The trajectory is the run's record: read and check it even though the replay files
+    // hold what the page shows.
+    let (_, trajectory) = read_trajectory(dir)?;
+    if trajectory.len() != rows.len() {
+        return Err(bad(
+            dir,
+            format!(
+                "trajectory.csv has {} rows and poses.csv {}",
+                trajectory.len(),
+                rows.len()
+            ),
+        ));
+    }
+    let t: Vec<f64> = rows.iter().map(|row| r(row[0], 6)).collect();
+    let column = |header: &[String], name: &str, file: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| bad(dir, format!("{file} has no column {name}")))
+    };
+    let mut carry = serde_json::Map::new();
+    for f in &frame_names {
+        let col = column(&header, &format!("{f}_angle_rad"), "poses.csv")?;
+        let take = |k: usize, digits: i32| -> Vec<f64> {
+            rows.iter().map(|row| r(row[col + k], digits)).collect()
+        };
+        carry.insert(
+            f.clone(),
+            json!({"a": take(0, 6), "x": take(1, 3), "y": take(2, 3)}),
+        );
+    }
+    let (header, crow) = read_numeric_csv(dir, "contacts.csv")?;
+    if crow.len() != rows.len() {
+        return Err(bad(
+            dir,
+            format!(
+                "contacts.csv has {} rows and poses.csv {}",
+                crow.len(),
+                rows.len()
+            ),
+        ));
+    }
+    let contact_names: Vec<String> = header
+        .iter()
+        .filter_map(|h| h.strip_suffix("_active"))
+        .map(str::to_string)
+        .collect();
+    let mut forces = serde_json::Map::new();
+    for name in &contact_names {
+        let col = column(&header, &format!("{name}_force_n"), "contacts.csv")?;
+        let active = column(&header, &format!("{name}_active"), "contacts.csv")?;
+        // Arrows show the force on a contact's second body, the part acted on; the finger's
+        // pad is that body in the model, but the arrow named "finger on key" is the force
+        // on the key.
+        let sign = if name == "presser_key" { -1.0 } else { 1.0 };
+        let mut slot: [Vec<f64>; 5] = Default::default();
+        for row in &crow {
+            let on = row[active] > 0.5 && row[col] > 0.0;
+            slot[0].push(r(if on { row[col] } else { 0.0 }, 3));
+            for k in 0..4 {
+                let v = row[col + 1 + k] * if k < 2 { 1.0 } else { sign };
+                slot[1 + k].push(if on {
+                    r(v, if k < 2 { 2 } else { 3 })
+                } else {
+                    0.0
+                });
+            }
+        }
+        let [f, px, py, nx, ny] = slot;
+        forces.insert(
+            name.clone(),
+            json!({"f": f, "px": px, "py": py, "nx": nx, "ny": ny}),
+        );
+    }
+    let contact_labels: serde_json::Map<String, Value> = contact_names
+        .iter()
+        .map(|c| (c.clone(), json!(contact_label(c, &scenario.input))))
+        .collect();
+    let (header, srow) = read_numeric_csv(dir, "series.csv")?;
+    let mut series: Vec<(&str, &str, Vec<f64>)> = Vec::new();
+    for (id, label) in GRAND_SERIES {
+        if let Some(col) = header.iter().position(|h| h == id) {
+            let digits = if id == "key_drive_force_n" { 3 } else { 4 };
+            series.push((
+                id,
+                label,
+                srow.iter().map(|row| r(row[col], digits)).collect(),
+            ));
+        }
+    }
+    let measured = read_measured(dir, &series)?;
+    let events = read_json(dir, "events.json")?;
+    Ok(json!({
+        "name": run_name(dir),
+        "title": format!("{} action, {}", kind.name(), describe(&scenario.input)),
+        "model": kind.name(),
+        "scene": frames,
+        "t": t,
+        "carry": carry,
+        "contacts": forces,
+        "contact_labels": contact_labels,
+        "series": series_to_json(series),
+        "events": events,
+        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
+        "summary": read_json(dir, "summary.json")?,
+        "zoom": scene_file["zoom"].clone(),
         "measured": measured,
     }))
 }

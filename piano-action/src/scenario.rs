@@ -693,6 +693,7 @@ pub fn is_run_output(name: &str) -> bool {
             | "contacts.csv"
             | "poses.csv"
             | "series.csv"
+            | "scene.json"
             | "events.json"
             | "summary.json"
             | "report.html"
@@ -784,12 +785,25 @@ pub fn prepare_run_dir(dir: &Path, replace: bool) -> Result<()> {
 /// Creates the run directory and writes `run.json` (scenario, parameters, version); a
 /// folder holding an earlier run is refused (see [`prepare_run_dir`]).
 fn start_run_dir(dir: &Path, scenario: &Scenario, params: &ActionParams) -> Result<()> {
+    start_run_dir_with(dir, scenario, params, serde_json::json!({}))
+}
+
+/// [`start_run_dir`] with more fields in `run.json` (an object's fields).
+fn start_run_dir_with(
+    dir: &Path,
+    scenario: &Scenario,
+    params: &ActionParams,
+    more: serde_json::Value,
+) -> Result<()> {
     prepare_run_dir(dir, false)?;
-    let run_json = serde_json::json!({
+    let mut run_json = serde_json::json!({
         "scenario": serde_json::to_value(scenario).unwrap_or_default(),
         "params": serde_json::to_value(params).unwrap_or_default(),
         "version": env!("CARGO_PKG_VERSION"),
     });
+    if let (Some(obj), Some(more)) = (run_json.as_object_mut(), more.as_object()) {
+        obj.extend(more.clone());
+    }
     write_json(dir, "run.json", &run_json)
 }
 
@@ -797,9 +811,11 @@ fn num(x: Option<f64>) -> serde_json::Value {
     x.map_or(serde_json::Value::Null, serde_json::Value::from)
 }
 
-/// Writes the run directory `dir` (created if needed): `run.json` (scenario and
-/// parameters), `trajectory.csv` (time, coordinates, velocities on the output grid),
-/// `contacts.csv` (gaps and normal forces on the same grid), `events.json`,
+/// Writes the run directory `dir` (created if needed): `run.json` (scenario, parameters,
+/// the expanded description and the initial state), `trajectory.csv` (time, coordinates,
+/// velocities on the output grid), `contacts.csv` (gaps, normal forces, points, normals and
+/// whether pressed, on the same grid), `poses.csv`, `series.csv` and `scene.json` (what the
+/// report replays without rebuilding the action), `events.json`,
 /// `summary.json` (strikes, key start, travel, let-off, key-bottom and check times,
 /// events) and the drawings `drawing_rest.svg`, `drawing_let_off.svg`,
 /// `drawing_string_contact.svg` and `drawing_check.svg` (those that happen).
@@ -809,11 +825,18 @@ pub fn write_run_dir(
     params: &ActionParams,
     run: &Run,
 ) -> Result<()> {
-    start_run_dir(dir, scenario, params)?;
-
     // The action as the run had it (with a presser, if any), for the names, the contacts
-    // and the drawings.
+    // and the drawings; run.json keeps its expanded description and the initial state.
     let prepared = crate::simulate::prepare(params, run.kind, &scenario.input.to_input()?)?;
+    start_run_dir_with(
+        dir,
+        scenario,
+        params,
+        serde_json::json!({
+            "mechanism": serde_json::to_value(&prepared.action.mechanism).unwrap_or_default(),
+            "initial_state": prepared.x0,
+        }),
+    )?;
     let sol = &run.solution;
     let extra = (run.key_drive_force_n.len() == sol.len())
         .then_some(("key_drive_force_n", run.key_drive_force_n.as_slice()));
@@ -926,19 +949,33 @@ fn write_contacts_and_drawings(dir: &Path, prepared: &Prepared, run: &Run) -> Re
     let names: Vec<&str> = action.contacts.keys().map(String::as_str).collect();
     let mut csv = String::from("time_s");
     for n in &names {
-        let _ = write!(csv, ",{n}_gap_mm,{n}_force_n");
+        let _ = write!(
+            csv,
+            ",{n}_gap_mm,{n}_force_n,{n}_px_mm,{n}_py_mm,{n}_nx,{n}_ny,{n}_active"
+        );
     }
     csv.push('\n');
     for i in 0..sol.len() {
         let (t, x) = (sol.t[i], sol.state(i));
         let _ = write!(csv, "{t}");
         for n in &names {
-            let out = action.contact_output(n, t, x)?;
-            let _ = write!(csv, ",{},{}", out.gap * 1e3, out.normal_force);
+            let o = action.contact_output(n, t, x)?;
+            let _ = write!(
+                csv,
+                ",{},{},{},{},{},{},{}",
+                o.gap * 1e3,
+                o.normal_force,
+                o.point[0] * 1e3,
+                o.point[1] * 1e3,
+                o.normal[0],
+                o.normal[1],
+                u8::from(o.active)
+            );
         }
         csv.push('\n');
     }
     write_file(dir, "contacts.csv", &csv)?;
+    crate::report::write_replay_files(dir, prepared, run)?;
 
     // The state at an event is the integrator's, just past the crossing.
     let at = |time: Option<f64>| {

@@ -315,3 +315,35 @@ fn the_finger_on_key_arrow_pushes_the_key_down() {
     let ny = c["ny"][peak].as_f64().unwrap();
     assert!(ny < -0.9, "finger-on-key arrow direction {ny}");
 }
+
+/// A run directory replays from its own files (poses, series, contact points, the scene):
+/// the report's data are the same as when the action is rebuilt and settled again, as it
+/// is for a run directory written before those files, for a touch, a key motion and a
+/// dropped mass.
+#[test]
+fn a_run_replays_from_its_files_exactly_as_rebuilt() {
+    let motion = "model = \"single\"\nduration_s = 0.12\n[input]\nkind = \"motion\"\npoints = [[0.0, 0.0], [0.04, 10.0], [0.12, 10.0]]\n";
+    let drop = "model = \"double\"\nduration_s = 0.12\n[input]\nkind = \"mass_drop\"\nmass_kg = 1.0\nheight_m = 0.0\n";
+    for (name, scenario) in [
+        ("replay-struck", STRUCK),
+        ("replay-motion", motion),
+        ("replay-drop", drop),
+    ] {
+        let dir = run_dir(name, scenario);
+        for file in ["poses.csv", "series.csv", "scene.json"] {
+            assert!(dir.join(file).is_file(), "{name}: {file}");
+        }
+        let run: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();
+        assert!(
+            run["mechanism"]["bodies"].is_array(),
+            "run.json keeps the description"
+        );
+        assert!(run["initial_state"].is_array(), "and the initial state");
+        let from_files = embedded(&report_html(std::slice::from_ref(&dir)).unwrap());
+        // An older run directory: no replay files, so the action is rebuilt and settled.
+        std::fs::remove_file(dir.join("scene.json")).unwrap();
+        let rebuilt = embedded(&report_html(std::slice::from_ref(&dir)).unwrap());
+        assert_eq!(from_files, rebuilt, "{name}");
+    }
+}
