@@ -11,7 +11,7 @@ use mbs_contact::laws::{
 };
 use mbs_contact::materials::{Material, MaterialLaw};
 use mbs_integrators::{
-    Direction, Event, EventAction, Method, OdeSystem, Options, SystemError, solve_with_events,
+    Crossing, Event, EventAction, Method, OdeSystem, Options, SystemError, solve_with_events,
 };
 
 // ---------------------------------------------------------------------------------------
@@ -79,8 +79,8 @@ impl OdeSystem for Impact<'_> {
         Ok(())
     }
 
-    fn event_direction(&self, _k: usize) -> Direction {
-        Direction::Falling
+    fn event_direction(&self, _k: usize) -> Crossing {
+        Crossing::Falling
     }
 }
 
@@ -541,8 +541,8 @@ impl OdeSystem for Ball<'_> {
         Ok(())
     }
 
-    fn event_direction(&self, _k: usize) -> Direction {
-        Direction::Both
+    fn event_direction(&self, _k: usize) -> Crossing {
+        Crossing::Both
     }
 }
 

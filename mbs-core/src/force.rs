@@ -138,7 +138,10 @@ impl<'a> Loads<'a> {
     }
 }
 
-/// Direction in which a switching function's zero crossing counts as an event.
+/// Direction of a switching function's zero crossing: which crossings count as events
+/// (declared by an element, see [`ForceElement::switch_direction`]), and which way an event
+/// went (recorded by the integrators, never `Both` there). The one crossing type of the
+/// core and the integrators.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Crossing {
     /// From negative to positive.
@@ -147,6 +150,31 @@ pub enum Crossing {
     Falling,
     /// Either way.
     Both,
+}
+
+impl Crossing {
+    /// Whether going from `g0` to `g1` is a crossing in this direction. Zero counts as the
+    /// non-negative side, so a crossing is never counted twice and a function reset to
+    /// exactly zero still sees its next crossing.
+    pub fn crosses(self, g0: f64, g1: f64) -> bool {
+        let rising = g0 < 0.0 && g1 >= 0.0;
+        let falling = g0 >= 0.0 && g1 < 0.0;
+        match self {
+            Crossing::Rising => rising,
+            Crossing::Falling => falling,
+            Crossing::Both => rising || falling,
+        }
+    }
+
+    /// The way a function went from `g0` (before) to the other side: `Rising` from a
+    /// negative value, `Falling` from a non-negative one.
+    pub fn observed(g0: f64) -> Crossing {
+        if g0 < 0.0 {
+            Crossing::Rising
+        } else {
+            Crossing::Falling
+        }
+    }
 }
 
 /// A source of generalized forces: a spring, friction, a contact, an input. Elements are

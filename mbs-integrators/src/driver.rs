@@ -4,7 +4,7 @@
 use crate::dopri5::Dopri5;
 use crate::error::{IntegratorError, Result};
 use crate::explicit::{Explicit, Scheme};
-use crate::ode::OdeSystem;
+use crate::ode::{Crossing, OdeSystem};
 use crate::options::{Method, Options};
 use crate::solution::{Event, EventAction, Solution, Stats, Termination};
 use crate::stepper::{Control, Stepper};
@@ -296,7 +296,7 @@ impl<'s> Run<'s> {
         }
         let (t0, t1) = (st.t_prev(), st.t());
         // Found crossings: (time, function).
-        let mut found: Vec<(f64, usize)> = Vec::new();
+        let mut found: Vec<(f64, usize, Crossing)> = Vec::new();
         self.g_a.copy_from_slice(&self.g_prev);
         let mut ta = t0;
         for s in 1..=self.samples {
@@ -319,7 +319,7 @@ impl<'s> Run<'s> {
                 let dir = self.sys.event_direction(k);
                 if dir.crosses(self.g_a[k], self.g_b[k]) {
                     let tk = self.locate(st, k, ta, tb, self.g_a[k], self.g_b[k])?;
-                    found.push((tk, k));
+                    found.push((tk, k, Crossing::observed(self.g_a[k])));
                 }
             }
             ta = tb;
@@ -327,11 +327,13 @@ impl<'s> Run<'s> {
         }
         self.g_end.copy_from_slice(&self.g_b);
         found.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for (te, k) in found {
+        for (te, k, direction) in found {
             let mut y = vec![0.0; self.n];
             st.interpolate(te, &mut y);
             let mut event = Event {
                 index: k,
+                direction,
+                source: self.sys.event_source(k),
                 name: self.sys.event_name(k),
                 time: te,
                 state: y.clone(),
@@ -374,7 +376,7 @@ impl<'s> Run<'s> {
         gb: f64,
     ) -> Result<f64> {
         let (mut a, mut b, mut fa, mut fb) = (ta, tb, ga, gb);
-        // Sides: negative, or non-negative (zero included), as in `Direction::crosses`.
+        // Sides: negative, or non-negative (zero included), as in `Crossing::crosses`.
         let a_negative = ga < 0.0;
         let mut side = 0i32;
         let mut y = vec![0.0; self.n];

@@ -14,10 +14,12 @@
 //! solution on a uniform grid, and counts its work. Failures (step size below the minimum,
 //! non-finite state, Newton failure) are errors that say when and why.
 //!
-//! With the default feature `mbs-core`, [`MultibodyOde`] runs an `mbs_core::System`.
+//! [`MultibodyOde`] runs an `mbs_core::System`; its events name the element that raised them
+//! ([`Event::source`]) and, like every event, the way they crossed ([`Event::direction`],
+//! the core's [`Crossing`]: one crossing type for the core and the integrators).
 //!
 //! ```
-//! use mbs_integrators::{Direction, EventAction, Method, OdeSystem, Options, SystemError,
+//! use mbs_integrators::{Crossing, EventAction, Method, OdeSystem, Options, SystemError,
 //!                       solve_with_events};
 //! /// A ball falling from 1 m that bounces with restitution 0.5.
 //! struct Ball;
@@ -33,7 +35,7 @@
 //!         g[0] = y[0];
 //!         Ok(())
 //!     }
-//!     fn event_direction(&self, _k: usize) -> Direction { Direction::Falling }
+//!     fn event_direction(&self, _k: usize) -> Crossing { Crossing::Falling }
 //! }
 //! let opts = Options::with_tolerances(1e-10, 1e-12);
 //! let sol = solve_with_events(&mut Ball, Method::DormandPrince54, 0.0, &[1.0, 0.0], 1.0, &opts,
@@ -51,7 +53,6 @@ mod driver;
 mod error;
 mod explicit;
 mod linalg;
-#[cfg(feature = "mbs-core")]
 mod multibody;
 mod ode;
 mod options;
@@ -62,8 +63,7 @@ mod trbdf2;
 
 pub use driver::{solve, solve_observed, solve_with_events};
 pub use error::{IntegratorError, Result, SystemError};
-#[cfg(feature = "mbs-core")]
 pub use multibody::MultibodyOde;
-pub use ode::{Direction, OdeSystem};
+pub use ode::{Crossing, EventSource, OdeSystem};
 pub use options::{Method, Options};
 pub use solution::{Event, EventAction, Solution, Stats, Termination};

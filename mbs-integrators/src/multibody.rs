@@ -3,7 +3,7 @@
 use mbs_core::{Crossing, System, Workspace};
 
 use crate::error::SystemError;
-use crate::ode::{Direction, OdeSystem};
+use crate::ode::{EventSource, OdeSystem};
 
 /// An `mbs_core::System` seen as an [`OdeSystem`]: the state is the system's
 /// `[q, v, internal states]`, the switching functions are the force elements', named
@@ -73,12 +73,16 @@ impl OdeSystem for MultibodyOde<'_> {
             .map_err(SystemError::new)
     }
 
-    fn event_direction(&self, k: usize) -> Direction {
-        match self.system.switch_info(k).map(|(_, _, c)| c) {
-            Some(Crossing::Rising) => Direction::Rising,
-            Some(Crossing::Falling) => Direction::Falling,
-            _ => Direction::Both,
-        }
+    fn event_direction(&self, k: usize) -> Crossing {
+        self.system
+            .switch_info(k)
+            .map_or(Crossing::Both, |(_, _, c)| c)
+    }
+
+    fn event_source(&self, k: usize) -> Option<EventSource> {
+        self.system
+            .switch_info(k)
+            .map(|(element, local, _)| EventSource { element, local })
     }
 
     fn event_name(&self, k: usize) -> String {

@@ -4,30 +4,17 @@ use nalgebra::DMatrix;
 
 use crate::error::SystemError;
 
-/// Which zero crossings of a switching function are events.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Direction {
-    /// From negative to positive.
-    Rising,
-    /// From positive to negative.
-    Falling,
-    /// Either way.
-    Both,
-}
+pub use mbs_core::Crossing;
 
-impl Direction {
-    /// Whether going from `g0` to `g1` is a crossing in this direction. Zero counts as the
-    /// non-negative side, so a crossing is never counted twice and a function reset to
-    /// exactly zero still sees its next crossing.
-    pub fn crosses(self, g0: f64, g1: f64) -> bool {
-        let rising = g0 < 0.0 && g1 >= 0.0;
-        let falling = g0 >= 0.0 && g1 < 0.0;
-        match self {
-            Direction::Rising => rising,
-            Direction::Falling => falling,
-            Direction::Both => rising || falling,
-        }
-    }
+/// Where a switching function comes from in the system that declared it: for a multibody
+/// system, the force element (its index in the `System`) and the function's index among
+/// that element's own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EventSource {
+    /// The element that raised it.
+    pub element: usize,
+    /// Its index among the element's switching functions.
+    pub local: usize,
 }
 
 /// A first-order system `ẏ = f(t, y)` with optional Jacobian and switching functions.
@@ -88,8 +75,14 @@ pub trait OdeSystem {
     }
 
     /// Which crossings of switching function `k` are events.
-    fn event_direction(&self, _k: usize) -> Direction {
-        Direction::Both
+    fn event_direction(&self, _k: usize) -> Crossing {
+        Crossing::Both
+    }
+
+    /// Where switching function `k` comes from (the element of a multibody system), if the
+    /// system says.
+    fn event_source(&self, _k: usize) -> Option<EventSource> {
+        None
     }
 
     /// A name for switching function `k`, used in the event list.

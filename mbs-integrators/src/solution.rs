@@ -17,6 +17,11 @@ pub enum EventAction {
 pub struct Event {
     /// Index of the switching function.
     pub index: usize,
+    /// Which way it crossed zero (`Rising` or `Falling`, never `Both`).
+    pub direction: crate::Crossing,
+    /// Where the switching function comes from (the element of a multibody system), when
+    /// the system says.
+    pub source: Option<crate::EventSource>,
     /// Its name.
     pub name: String,
     /// Time of the zero crossing (located to the event tolerance; just after the crossing).

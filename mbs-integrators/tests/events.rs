@@ -2,7 +2,7 @@
 //! the record / stop / reset actions.
 
 use mbs_integrators::{
-    Direction, EventAction, Method, OdeSystem, Options, SystemError, Termination, solve_with_events,
+    Crossing, EventAction, Method, OdeSystem, Options, SystemError, Termination, solve_with_events,
 };
 
 const G: f64 = 9.81;
@@ -29,8 +29,8 @@ impl OdeSystem for Ball {
         g[0] = y[0];
         Ok(())
     }
-    fn event_direction(&self, _k: usize) -> Direction {
-        Direction::Falling
+    fn event_direction(&self, _k: usize) -> Crossing {
+        Crossing::Falling
     }
     fn event_name(&self, _k: usize) -> String {
         "impact".into()
@@ -128,7 +128,7 @@ fn rapid_bounces_are_all_found() {
 
 /// ẏ = 1 with switching functions y − a_k, each in its own direction.
 struct Clock {
-    marks: Vec<(f64, Direction)>,
+    marks: Vec<(f64, Crossing)>,
 }
 
 impl OdeSystem for Clock {
@@ -145,7 +145,7 @@ impl OdeSystem for Clock {
     fn events(&mut self, _t: f64, y: &[f64], g: &mut [f64]) -> Result<(), SystemError> {
         for (gk, (a, dir)) in g.iter_mut().zip(&self.marks) {
             // Falling marks see a decreasing function.
-            *gk = if *dir == Direction::Falling {
+            *gk = if *dir == Crossing::Falling {
                 a - y[0]
             } else {
                 y[0] - a
@@ -153,7 +153,7 @@ impl OdeSystem for Clock {
         }
         Ok(())
     }
-    fn event_direction(&self, k: usize) -> Direction {
+    fn event_direction(&self, k: usize) -> Crossing {
         self.marks[k].1
     }
     fn event_name(&self, k: usize) -> String {
@@ -165,9 +165,9 @@ impl OdeSystem for Clock {
 fn events_close_together_are_all_reported_in_time_order() {
     // Three functions crossing within 2e-7 s of each other, inside one big step.
     let marks = vec![
-        (0.5000002, Direction::Rising),
-        (0.5, Direction::Rising),
-        (0.5000001, Direction::Falling),
+        (0.5000002, Crossing::Rising),
+        (0.5, Crossing::Rising),
+        (0.5000001, Crossing::Falling),
     ];
     let mut clock = Clock { marks };
     let opts = Options::default().fixed(0.25);
@@ -194,7 +194,7 @@ fn events_close_together_are_all_reported_in_time_order() {
 /// A switching function sin(ω t) driven by time only.
 struct Wave {
     omega: f64,
-    direction: Direction,
+    direction: Crossing,
 }
 
 impl OdeSystem for Wave {
@@ -212,7 +212,7 @@ impl OdeSystem for Wave {
         g[0] = (self.omega * t).sin();
         Ok(())
     }
-    fn event_direction(&self, _k: usize) -> Direction {
+    fn event_direction(&self, _k: usize) -> Crossing {
         self.direction
     }
 }
@@ -225,11 +225,11 @@ fn directions_select_crossings_even_two_within_one_step() {
     let opts = Options::default().fixed(0.35);
     for (direction, expect) in [
         (
-            Direction::Both,
+            Crossing::Both,
             vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9],
         ),
-        (Direction::Falling, vec![0.1, 0.3, 0.5, 0.7, 0.9]),
-        (Direction::Rising, vec![0.2, 0.4, 0.6, 0.8]),
+        (Crossing::Falling, vec![0.1, 0.3, 0.5, 0.7, 0.9]),
+        (Crossing::Rising, vec![0.2, 0.4, 0.6, 0.8]),
     ] {
         let mut wave = Wave { omega, direction };
         let sol = solve_with_events(
@@ -246,6 +246,18 @@ fn directions_select_crossings_even_two_within_one_step() {
         assert_eq!(times.len(), expect.len(), "{direction:?}: {times:?}");
         for (t, want) in times.iter().zip(&expect) {
             assert!((t - want).abs() < 1e-10, "{direction:?}: {t} vs {want}");
+        }
+        // Each event records the way it crossed: sin falls through zero at odd tenths and
+        // rises at even ones; a plain ODE names no element.
+        for e in &sol.events {
+            let odd = ((e.time / 0.1).round() as i64) % 2 == 1;
+            let want = if odd {
+                Crossing::Falling
+            } else {
+                Crossing::Rising
+            };
+            assert_eq!(e.direction, want, "at {}", e.time);
+            assert_eq!(e.source, None);
         }
     }
 }

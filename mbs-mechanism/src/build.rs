@@ -144,7 +144,7 @@ pub struct Built {
     /// The system to integrate.
     pub system: System,
     /// Element index of every named element (springs, cords, loads, contacts, strings,
-    /// extensions), by name.
+    /// extensions, and `"<body> limits"` for a joint's stops), by name.
     pub elements: BTreeMap<String, usize>,
     /// Element index of each contact and string, by name.
     pub contacts: BTreeMap<String, usize>,
@@ -435,7 +435,8 @@ impl Mechanism {
                     l.damping,
                 )
                 .map_err(core(&f))?;
-                system.add_element(e).map_err(core(&f))?;
+                let index = system.add_element(e).map_err(core(&f))?;
+                elements.insert(format!("{} limits", body.name), index);
             }
         }
         if !self.extensions.is_empty() {

@@ -34,29 +34,13 @@ fn core(e: mbs_core::CoreError) -> MechanismError {
     MechanismError::caused("", e)
 }
 
-/// Whether the integrator event `index` at `(t, x)` is the onset (`true`) or release of the
-/// contact whose element is `element`: the event's state lies just past the crossing, so a
-/// negative gap is an onset.
-fn is_onset(built: &Built, element: usize, t: f64, x: &[f64]) -> Result<bool> {
-    let system = &built.system;
-    let mut ws = system.workspace();
-    let ctx = system
-        .element_context(&mut ws, t, x, element)
-        .map_err(core)?;
-    let mut g = [0.0];
-    if let Some(e) = system.elements().nth(element) {
-        e.switching_functions(&ctx, &mut g[..e.switch_count().min(1)]);
-    }
-    Ok(g[0] < 0.0)
-}
-
 impl Mechanism {
     /// The occurrences of the description's named events in `solution` (integrated from
     /// `built`, which this description built), in time order.
     pub fn events_in(&self, built: &Built, solution: &Solution) -> Result<Vec<EventOccurrence>> {
         let mut out = Vec::new();
         for (record, ev) in solution.events.iter().enumerate() {
-            let Some((element, local, _)) = built.system.switch_info(ev.index) else {
+            let Some(mbs_integrators::EventSource { element, local }) = ev.source else {
                 continue;
             };
             for spec in &self.events {
@@ -65,7 +49,9 @@ impl Mechanism {
                         if built.contacts.get(c) != Some(&element) || local != 0 {
                             continue;
                         }
-                        let onset = is_onset(built, element, ev.time, &ev.state)?;
+                        // A contact's switching function is its gap: falling, the shapes
+                        // touch.
+                        let onset = ev.direction == mbs_integrators::Crossing::Falling;
                         onset == (phase == ContactPhase::Onset)
                     }
                     _ => built.watches.get(&spec.name) == Some(&element),

@@ -87,6 +87,25 @@ fn events_and_metrics_follow_the_physics() {
         names.contains(&"leaves"),
         "the rod bounces off the felt: {names:?}"
     );
+    // The integrator's events name the element that raised them and the way it crossed:
+    // the stop's gap falls through zero as the rod lands and rises as it leaves.
+    let stop = built.contacts["stop"];
+    let stop_events: Vec<_> = sol
+        .events
+        .iter()
+        .filter(|e| e.source.map(|s| s.element) == Some(stop))
+        .collect();
+    assert!(stop_events.len() >= 2);
+    assert_eq!(stop_events[0].direction, mbs_integrators::Crossing::Falling);
+    assert_eq!(stop_events[1].direction, mbs_integrators::Crossing::Rising);
+    assert_eq!(stop_events[0].time, events[1].time_s);
+    let watch = built.watches["thirty degrees down"];
+    assert!(
+        sol.events
+            .iter()
+            .any(|e| e.source.map(|s| s.element) == Some(watch)
+                && e.direction == mbs_integrators::Crossing::Falling)
+    );
     let metrics = m.metrics_in(&built, &sol).unwrap();
     // Energy: I_O ω² / 2 = m g (L/2) sin 30°, tip speed L ω.
     let (mass, l, g) = (0.1f64, 0.1f64, 9.81f64);

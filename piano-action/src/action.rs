@@ -69,6 +69,8 @@ pub struct Action {
     pub contacts: BTreeMap<String, usize>,
     /// Each contact with its type (shapes and outputs without a downcast), by name.
     pub contact_handles: BTreeMap<String, ContactHandle>,
+    /// Element index of every named element (springs, contacts, `"jack limits"`, ...).
+    pub elements: BTreeMap<String, usize>,
     /// The presser over the key front (a weight or a finger), if it was built with one.
     pub presser: Option<Presser>,
     /// The description the system was built from (a run directory keeps it).
@@ -161,6 +163,7 @@ impl Action {
             system: built.system,
             contacts: built.contacts,
             contact_handles: built.contact_handles,
+            elements: built.elements,
             presser,
             mechanism: mechanism.clone(),
         })

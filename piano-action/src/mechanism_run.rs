@@ -173,12 +173,12 @@ pub fn simulate_mechanism(
     let metrics = mechanism.metrics_in(&built, &solution)?;
     let mut contact_events = Vec::new();
     for ev in &solution.events {
-        let Some((element, 0, _)) = built.system.switch_info(ev.index) else {
+        let Some(mbs_integrators::EventSource { element, local: 0 }) = ev.source else {
             continue;
         };
         if let Some((name, _)) = built.contacts.iter().find(|(_, e)| **e == element) {
-            let gap = contact_gap(&built, element, ev.time, &ev.state)?;
-            contact_events.push((name.clone(), gap < 0.0, ev.time));
+            let onset = ev.direction == mbs_integrators::Crossing::Falling;
+            contact_events.push((name.clone(), onset, ev.time));
         }
     }
     Ok(MechanismRun {
@@ -190,20 +190,6 @@ pub fn simulate_mechanism(
         contact_events,
         metrics,
     })
-}
-
-/// The gap (m) of contact element `element` at `(t, x)`.
-fn contact_gap(built: &Built, element: usize, t: f64, x: &[f64]) -> Result<f64> {
-    let system = &built.system;
-    let mut ws = system.workspace();
-    let ctx = system.element_context(&mut ws, t, x, element)?;
-    let mut g = [0.0];
-    if let Some(e) = system.elements().nth(element)
-        && e.switch_count() > 0
-    {
-        e.switching_functions(&ctx, &mut g);
-    }
-    Ok(g[0])
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> Result<()> {

@@ -114,10 +114,11 @@ pub(crate) fn slow_press(
     // String contact before let-off (a jack that never lets go) spoils the measurement;
     // after it (a repetition lever throwing the hammer up) it is a drop problem.
     let before = let_off.map_or(solution.t_final, |i| solution.t[i]);
+    let string = a.contacts.get("hammer_string").copied();
     let touched = solution
         .events
         .iter()
-        .any(|e| e.name == "contact 'hammer_string' #0" && e.time <= before)
+        .any(|e| e.source.is_some_and(|s| Some(s.element) == string) && e.time <= before)
         || gap_mm[..let_off.unwrap_or(gap_mm.len())]
             .iter()
             .any(|&g| g <= 0.0);

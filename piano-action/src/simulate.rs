@@ -624,11 +624,14 @@ pub fn simulate_observed(
     let mut strikes: Vec<Strike> = Vec::new();
     // The jack is reset when it comes back to its stop under the knuckle after a let-off,
     // once the key has begun to rise from the front rail.
-    let jack_limit = "joint limit 'jack' #0";
+    // Events are read through the element that raised them and the way they crossed.
+    let jack_limit = action.elements.get("jack limits").copied();
     let jack = model.coordinate_id("jack").ok();
     let (mut escaped, mut key_rising) = (false, false);
     for ev in &solution.events {
-        if ev.name == jack_limit
+        let source = ev.source.map(|s| (s.element, s.local));
+        if source.is_some()
+            && source == jack_limit.map(|e| (e, 0))
             && let Some(j) = jack
             && ev.state[j] < params.jack.stop_angle_rad
             && escaped
@@ -641,9 +644,10 @@ pub fn simulate_observed(
             (escaped, key_rising) = (false, false);
         }
         for (contact, on, off) in EVENT_NAMES {
-            if ev.name == format!("contact '{contact}' #0") {
-                // The event state is just past the crossing: a negative gap is an onset.
-                let onset = action.gap(contact, ev.time, &ev.state)? < 0.0;
+            if source.is_some() && source == action.contacts.get(contact).map(|&e| (e, 0)) {
+                // A contact's switching function is its gap: falling through zero, the
+                // shapes touch.
+                let onset = ev.direction == mbs_integrators::Crossing::Falling;
                 let (on, off) = match input {
                     Input::MassDrop { .. } if contact == "presser_key" => ("mass_key", "mass_lift"),
                     _ => (on, off),

@@ -253,14 +253,14 @@ fn free_flight_mm(action: &Action, run: &Run) -> Result<Option<f64>> {
         return Ok(None);
     };
     let mut released: Option<f64> = None;
-    for e in run
-        .solution
-        .events
-        .iter()
-        .filter(|e| e.time < strike.time_s && e.name == "contact 'jack_knuckle' #0")
+    let knuckle = action.contacts.get("jack_knuckle").copied();
+    for e in
+        run.solution.events.iter().filter(|e| {
+            e.time < strike.time_s && e.source.is_some_and(|s| Some(s.element) == knuckle)
+        })
     {
-        // The event state is just past the crossing: an open gap is a release.
-        released = if action.gap("jack_knuckle", e.time, &e.state)? > 0.0 {
+        // The contact's switching function is its gap: rising through zero, it opens.
+        released = if e.direction == mbs_integrators::Crossing::Rising {
             Some(crown_to_string_mm(action, e.time, &e.state)?)
         } else {
             None
