@@ -380,5 +380,5 @@ pub fn integrate_system(
         &mut |_, _| EventAction::Record,
         progress,
     )
-    .map_err(|e| crate::PianoError::Simulation(e.to_string()))
+    .map_err(crate::PianoError::from)
 }

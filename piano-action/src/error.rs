@@ -99,9 +99,13 @@ pub enum PianoError {
         /// What went wrong.
         message: String,
     },
-    /// The integration failed (the integrator's message says when and why).
+    /// A simulation could not be done (no string to sound, a fit that found nothing).
     #[error("simulation failed: {0}")]
     Simulation(String),
+    /// The integration failed: the integrator's error, kept as the cause, says when and
+    /// why.
+    #[error("simulation failed: {0}")]
+    Integrator(#[from] mbs_integrators::IntegratorError),
     /// The multibody core refused something.
     #[error(transparent)]
     Core(#[from] mbs_core::CoreError),

@@ -361,7 +361,9 @@ fn simulate_scenario(
     let run = scenario
         .run_observed(params, &mut |t| progress.update(t))
         .map_err(|e| match e {
-            PianoError::Simulation(_) => format!("{}: {e}", path.display()),
+            PianoError::Simulation(_) | PianoError::Integrator(_) => {
+                format!("{}: {e}", path.display())
+            }
             e => e.to_string(),
         });
     progress.finish();

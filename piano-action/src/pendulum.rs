@@ -122,7 +122,7 @@ pub fn swing_sampled(
         &opts,
         &mut |_, _| EventAction::Record,
     )
-    .map_err(|e| PianoError::Simulation(e.to_string()))?;
+    .map_err(PianoError::from)?;
     let turns = sol
         .events
         .iter()

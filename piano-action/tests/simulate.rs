@@ -227,3 +227,28 @@ fn a_run_reports_its_progress_step_by_step_up_to_its_duration() {
     assert!((seen[seen.len() - 1] - 0.05).abs() < 1e-12);
     assert!(!run.strikes.is_empty());
 }
+
+/// An integration that cannot start keeps the integrator's error as its cause (a typed
+/// source, not a string).
+#[test]
+fn a_failed_integration_keeps_the_integrators_error() {
+    let action = piano_action::Action::build(
+        &piano_action::ActionParams::reference(),
+        piano_action::ModelKind::Double,
+    )
+    .unwrap();
+    let mut x0 = action.layout_state().unwrap();
+    x0[0] = f64::NAN;
+    let e = action.integrate(&x0, 0.01, 1e-3, None).unwrap_err();
+    assert!(
+        matches!(e, piano_action::PianoError::Integrator(_)),
+        "{e:?}"
+    );
+    assert!(e.to_string().starts_with("simulation failed: "), "{e}");
+    let cause = std::error::Error::source(&e).expect("the integrator's error is kept");
+    assert!(
+        cause
+            .downcast_ref::<mbs_integrators::IntegratorError>()
+            .is_some()
+    );
+}
