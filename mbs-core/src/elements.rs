@@ -186,6 +186,48 @@ impl ResolvedPoint {
     }
 }
 
+/// The line between two attached points at a state: their world positions, the unit
+/// vector from `a` to `b`, the distance and its rate.
+struct Line2 {
+    pa: [f64; 2],
+    pb: [f64; 2],
+    u: [f64; 2],
+    l: f64,
+    ldot: f64,
+}
+
+impl Line2 {
+    /// The line at the state in `ctx`, or `None` when the points are no farther apart than
+    /// `min_len` (or the distance is not a number).
+    fn between(
+        ctx: &ForceContext<'_>,
+        a: &ResolvedPoint,
+        b: &ResolvedPoint,
+        min_len: f64,
+    ) -> Option<Line2> {
+        let pa = ctx.point_position(a.body, a.point);
+        let pb = ctx.point_position(b.body, b.point);
+        let d = [pb[0] - pa[0], pb[1] - pa[1]];
+        let l = d[0].hypot(d[1]);
+        if l.is_nan() || l <= min_len {
+            return None;
+        }
+        let u = [d[0] / l, d[1] / l];
+        let va = ctx.point_velocity(a.body, a.point);
+        let vb = ctx.point_velocity(b.body, b.point);
+        // l̇ = (v_b − v_a) · u
+        let ldot = (vb[0] - va[0]) * u[0] + (vb[1] - va[1]) * u[1];
+        Some(Line2 { pa, pb, u, l, ldot })
+    }
+
+    /// A tension `t` along the line, pulling the points together when positive.
+    fn pull(&self, loads: &mut Loads<'_>, a: &ResolvedPoint, b: &ResolvedPoint, t: f64) {
+        let u = self.u;
+        loads.add_force_at_point(a.body, self.pa, [t * u[0], t * u[1]]);
+        loads.add_force_at_point(b.body, self.pb, [-t * u[0], -t * u[1]]);
+    }
+}
+
 /// A linear spring–damper between two body points (or a body point and a ground point):
 /// tension `T = preload + k (l − rest) + c l̇` along the line between the points,
 /// pulling them together when positive. When the points coincide the direction is undefined
@@ -250,23 +292,13 @@ impl ForceElement for PointSpringDamper {
     }
 
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
-        let (a, b) = (&self.a, &self.b);
-        let pa = ctx.point_position(a.body, a.point);
-        let pb = ctx.point_position(b.body, b.point);
-        let d = [pb[0] - pa[0], pb[1] - pa[1]];
-        let l = d[0].hypot(d[1]);
-        if l.is_nan() || l <= 1e-12 {
+        let Some(line) = Line2::between(ctx, &self.a, &self.b, 1e-12) else {
             return;
-        }
-        let u = [d[0] / l, d[1] / l];
-        let va = ctx.point_velocity(a.body, a.point);
-        let vb = ctx.point_velocity(b.body, b.point);
-        // l̇ = (v_b − v_a) · u ;  T = preload + k (l − l₀) + c l̇
-        let ldot = (vb[0] - va[0]) * u[0] + (vb[1] - va[1]) * u[1];
+        };
+        // T = preload + k (l − l₀) + c l̇
         let law = &self.law;
-        let t = law.preload + law.stiffness * (l - law.rest) + law.damping * ldot;
-        loads.add_force_at_point(a.body, pa, [t * u[0], t * u[1]]);
-        loads.add_force_at_point(b.body, pb, [-t * u[0], -t * u[1]]);
+        let t = law.preload + law.stiffness * (line.l - law.rest) + law.damping * line.ldot;
+        line.pull(loads, &self.a, &self.b, t);
     }
 
     fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
@@ -354,21 +386,11 @@ impl ForceElement for Cord {
     }
 
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
-        let (a, b) = (&self.a, &self.b);
-        let pa = ctx.point_position(a.body, a.point);
-        let pb = ctx.point_position(b.body, b.point);
-        let d = [pb[0] - pa[0], pb[1] - pa[1]];
-        let l = d[0].hypot(d[1]);
-        if l.is_nan() || l <= self.length {
+        // Slack (or its ends together): no force.
+        let Some(line) = Line2::between(ctx, &self.a, &self.b, self.length) else {
             return;
-        }
-        let u = [d[0] / l, d[1] / l];
-        let va = ctx.point_velocity(a.body, a.point);
-        let vb = ctx.point_velocity(b.body, b.point);
-        let ldot = (vb[0] - va[0]) * u[0] + (vb[1] - va[1]) * u[1];
-        let t = self.tension(l, ldot);
-        loads.add_force_at_point(a.body, pa, [t * u[0], t * u[1]]);
-        loads.add_force_at_point(b.body, pb, [-t * u[0], -t * u[1]]);
+        };
+        line.pull(loads, &self.a, &self.b, self.tension(line.l, line.ldot));
     }
 
     fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
