@@ -3,8 +3,8 @@
 //! slower speed) and moves the hammer, the scrubber, `#t=` and plot clicks seek, the string
 //! arrow shows at string contact, and no two labels on the 2D view overlap or leave it.
 //! Then the report of mechanism descriptions that are not the grand action
-//! (tests/browser/mechanism.test.mjs): the keyboard glockenspiel of
-//! `examples/mechanisms/`, its key moving, its strike pressed and drawn in 2D and 3D.
+//! (tests/browser/mechanism.test.mjs): the keyboard glockenspiel and the upright action of
+//! `examples/mechanisms/`, a body moving, the strike pressed and drawn in 2D and 3D.
 //!
 //! Needs Node.js, Chromium (Debian's `chromium`) and `npm ci --prefix
 //! piano-action/tests/browser`, which `.ci/run` installs. This test has its own `main`
@@ -166,9 +166,10 @@ fn checks(here: &std::path::Path, chromium: &str) -> Result<(), String> {
 /// named event.
 fn mechanism_checks(here: &std::path::Path, chromium: &str) -> Result<(), String> {
     let examples = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/mechanisms");
-    for (file, body, contact, event, force_n) in
-        [("glockenspiel.toml", "key", "head_bar", "strike", 6.0)]
-    {
+    for (file, body, contact, event, force_n) in [
+        ("glockenspiel.toml", "key", "head_bar", "strike", 6.0),
+        ("upright.toml", "hammer", "hammer_string", "strike", 10.0),
+    ] {
         let mechanism = piano_action::mechanism::Mechanism::load(&examples.join(file))
             .map_err(|e| e.to_string())?;
         let scenario = Scenario::for_mechanism(

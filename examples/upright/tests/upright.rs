@@ -112,3 +112,16 @@ fn a_harder_key_force_throws_the_hammer_faster() {
     // pp to ff on a real piano: about 0.5-7 m/s at the crown (literature.md §3).
     assert!(speeds[0] > 0.5 && speeds[2] < 8.0, "{speeds:?} m/s");
 }
+
+/// `examples/mechanisms/upright.toml` is this description as a file (what the browser test
+/// and `piano simulate` read): it must stay what the code writes.
+#[test]
+fn the_description_file_is_what_the_code_writes() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mechanisms/upright.toml");
+    let file = piano_action::mechanism::Mechanism::load(&path).expect("the file reads");
+    assert_eq!(
+        file,
+        upright_mechanism().unwrap(),
+        "regenerate it: cargo run --release --example upright && cp target/upright/upright.toml examples/mechanisms/"
+    );
+}
