@@ -615,7 +615,7 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
             onset("escape", "jack_seat", ContactPhase::Release),
             onset("strike", "hammer_string", ContactPhase::Onset),
             onset("check", "backcheck", ContactPhase::Onset),
-            onset("reseat", "jack_seat", ContactPhase::Onset),
+            onset("jack_on_seat", "jack_seat", ContactPhase::Onset),
         ],
         metrics: vec![
             Metric {
