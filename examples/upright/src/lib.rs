@@ -4,7 +4,7 @@
 //! cord), butt spring, jack spring, and the string in a vertical plane in front of the
 //! hammer.
 //!
-//! The layout is `upright_layout.md` (project reference), §4–§6, every value tagged there
+//! The layout is `docs/reference/upright_layout.md`, §4–§6, every value tagged there
 //! and here: \[V\] read in a source, \[S\] secondhand, \[M\] judged, \[D\] derived. Points
 //! are given in the layout's world frame (mm, origin at the balance pivot, x toward the
 //! strings, y up) and turned into each body's frame here, so the numbers can be checked
