@@ -240,10 +240,12 @@ impl<'s> Run<'s> {
                     break;
                 }
                 let tg = tg.min(t_until);
-                let mut y = vec![0.0; self.n];
+                // Into the scratch state, then appended: no allocation per output point.
+                let mut y = std::mem::take(&mut self.y_tmp);
                 st.interpolate(tg.max(st.t_prev()), &mut y);
                 self.t.push(tg);
                 self.y.extend_from_slice(&y);
+                self.y_tmp = y;
                 self.next_grid += 1;
             },
         }
@@ -306,8 +308,11 @@ impl<'s> Run<'s> {
                 t0 + (t1 - t0) * s as f64 / self.samples as f64
             };
             if s == self.samples {
-                let y = st.y().to_vec();
-                self.eval_events(tb, &y, true)?;
+                let mut y = std::mem::take(&mut self.y_tmp);
+                y.copy_from_slice(st.y());
+                let r = self.eval_events(tb, &y, true);
+                self.y_tmp = y;
+                r?;
             } else {
                 let mut y = std::mem::take(&mut self.y_tmp);
                 st.interpolate(tb, &mut y);

@@ -64,6 +64,16 @@ pub(crate) struct TrBdf2 {
     jac_tmp: Vec<f64>,
     /// Columns of `jac` known to hold zeros (left out of the last Jacobians).
     zero_columns: Vec<bool>,
+    /// Scratch of a Jacobian evaluation (no allocation per Jacobian): the state and rate it
+    /// is taken at, the perturbed state, which columns are needed, the internal states
+    /// probed together.
+    jac_y: Vec<f64>,
+    jac_f: Vec<f64>,
+    jac_yp: Vec<f64>,
+    jac_needed: Vec<bool>,
+    jac_internal: Vec<usize>,
+    /// The system's states outside the Jacobian, asked once per solve.
+    outside: Option<Vec<std::ops::Range<usize>>>,
     jac_valid: bool,
     /// Whether `jac` was evaluated at the start of the current step.
     jac_fresh: bool,
@@ -105,6 +115,12 @@ impl TrBdf2 {
             jac: nalgebra::DMatrix::zeros(n, n),
             jac_tmp: v(),
             zero_columns: vec![false; n],
+            jac_y: v(),
+            jac_f: v(),
+            jac_yp: v(),
+            jac_needed: vec![true; n],
+            jac_internal: Vec::with_capacity(n),
+            outside: None,
             jac_valid: false,
             jac_fresh: false,
             lu: IterationMatrix::new(n),
@@ -117,8 +133,16 @@ impl TrBdf2 {
     /// J at the start of the step: analytic if the system has one, else forward
     /// differences.
     fn update_jacobian(&mut self, sys: &mut dyn OdeSystem, st: &mut Stats) -> Result<()> {
-        let (t, y, f) = (self.t, self.y.clone(), self.f.clone());
-        self.jacobian_at(sys, t, &y, &f, st)
+        let mut y = std::mem::take(&mut self.jac_y);
+        let mut f = std::mem::take(&mut self.jac_f);
+        y.clear();
+        y.extend_from_slice(&self.y);
+        f.clear();
+        f.extend_from_slice(&self.f);
+        let done = self.jacobian_at(sys, self.t, &y, &f, st);
+        self.jac_y = y;
+        self.jac_f = f;
+        done
     }
 
     /// J at `(t, y)` where `f = f(t, y)`.
@@ -143,12 +167,19 @@ impl TrBdf2 {
             }
         } else {
             let n = self.n;
-            let mut yp = y.to_vec();
+            let mut yp = std::mem::take(&mut self.jac_yp);
+            yp.clear();
+            yp.extend_from_slice(y);
             // States the system marks as outside the Jacobian keep zero columns and cost
             // no evaluation (a string's modal amplitudes, see
             // `OdeSystem::states_outside_jacobian`).
-            let mut needed = vec![true; n];
-            for r in sys.states_outside_jacobian() {
+            let mut needed = std::mem::take(&mut self.jac_needed);
+            needed.clear();
+            needed.resize(n, true);
+            let outside = self
+                .outside
+                .get_or_insert_with(|| sys.states_outside_jacobian());
+            for r in outside.iter() {
                 for j in r.start.min(n)..r.end.min(n) {
                     needed[j] = false;
                 }
@@ -157,7 +188,9 @@ impl TrBdf2 {
             // memories) are probed together first: when moving them all at once changes no
             // derivative at all, their columns are zero and their evaluations are saved.
             let grouped = sys.second_order_split().map_or(n, |nv| (2 * nv).min(n));
-            let internal: Vec<usize> = (grouped..n).filter(|&j| needed[j]).collect();
+            let mut internal = std::mem::take(&mut self.jac_internal);
+            internal.clear();
+            internal.extend((grouped..n).filter(|&j| needed[j]));
             if internal.len() > 1 {
                 for &j in &internal {
                     yp[j] = y[j] + f64::EPSILON.sqrt() * y[j].abs().max(1e-5);
@@ -197,6 +230,9 @@ impl TrBdf2 {
                 self.zero_columns[j] = false;
                 yp[j] = yj;
             }
+            self.jac_yp = yp;
+            self.jac_needed = needed;
+            self.jac_internal = internal;
         }
         self.jac_valid = true;
         self.jac_fresh = true;
