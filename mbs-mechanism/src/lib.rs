@@ -47,9 +47,9 @@
 //! Tag every number with where it comes from in the `note` fields (and in comments of a
 //! TOML file): \[V\] read in a source, \[S\] secondhand, \[M\] recalled or judged, \[D\]
 //! derived. The repository's `examples/mechanisms/glockenspiel.toml` is a complete small
-//! description written by hand; `piano describe` writes the grand action (and
-//! `piano_action::describe::grand_mechanism` shows how a program writes one through the
-//! API).
+//! description written by hand; the `upright-action` crate (`examples/upright`) writes an
+//! upright piano action through the API from a sourced layout, its jack closing a four-bar
+//! through two contacts; `piano describe` writes the grand action.
 //!
 //! ```
 //! use mbs_mechanism::Mechanism;
