@@ -84,6 +84,29 @@ impl fmt::Display for InputError {
     }
 }
 
+/// An I/O error kept as an error's cause: shared, so that [`PianoError`] stays `Clone`;
+/// two are equal when they are of the same kind and say the same.
+#[derive(Clone, Debug)]
+pub struct IoCause(pub std::sync::Arc<std::io::Error>);
+
+impl fmt::Display for IoCause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for IoCause {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(self.0.as_ref())
+    }
+}
+
+impl PartialEq for IoCause {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.kind() == other.0.kind() && self.0.to_string() == other.0.to_string()
+    }
+}
+
 /// Errors of `piano-action`, each naming what is wrong.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PianoError {
@@ -98,6 +121,18 @@ pub enum PianoError {
         path: PathBuf,
         /// What went wrong.
         message: String,
+    },
+    /// A file or folder cannot be read, written, listed or removed: the operating system's
+    /// error is kept as the cause (its kind tells a missing file from a refused one).
+    #[error("{}: cannot {action}: {source}", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// What was being done: `read`, `write`, `create the folder`, ...
+        action: String,
+        /// The operating system's error.
+        #[source]
+        source: IoCause,
     },
     /// A simulation could not be done (no string to sound, a fit that found nothing).
     #[error("simulation failed: {0}")]
@@ -155,7 +190,18 @@ impl PianoError {
         Self::input(InputKind::Option, flag, message)
     }
 
-    /// A file or folder that cannot be read or written.
+    /// `action` (`"read"`, `"write"`, ...) on `path` failed with the operating system's
+    /// `error`.
+    pub fn io(path: &Path, action: impl Into<String>, error: std::io::Error) -> Self {
+        PianoError::Io {
+            path: path.to_path_buf(),
+            action: action.into(),
+            source: IoCause(std::sync::Arc::new(error)),
+        }
+    }
+
+    /// A file or folder that cannot be used, for a reason of ours (it would overwrite the
+    /// user's, it cannot be encoded); [`PianoError::io`] for the operating system's errors.
     pub fn file(path: &Path, message: impl Into<String>) -> Self {
         PianoError::File {
             path: path.to_path_buf(),
@@ -210,3 +256,34 @@ impl PianoError {
 
 /// Result alias of the crate.
 pub type Result<T> = std::result::Result<T, PianoError>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// A missing file keeps the operating system's error as the cause: its kind tells a
+    /// missing file from a refused one, and the message still names the file.
+    #[test]
+    fn io_errors_keep_their_cause() {
+        let path = Path::new("/nonexistent/piano/params.toml");
+        let e = crate::ActionParams::load(path).expect_err("no such file");
+        let PianoError::Io { source, .. } = &e else {
+            panic!("an I/O error, got {e:?}");
+        };
+        assert_eq!(source.0.kind(), std::io::ErrorKind::NotFound);
+        let text = e.to_string();
+        assert!(
+            text.starts_with("/nonexistent/piano/params.toml: cannot read"),
+            "{text}"
+        );
+        let cause = e.source().expect("a cause");
+        let io = cause
+            .source()
+            .and_then(|c| c.downcast_ref::<std::io::Error>())
+            .expect("the io::Error under it");
+        assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+        // Equal errors: the same place, kind and message.
+        assert_eq!(e, crate::ActionParams::load(path).unwrap_err());
+    }
+}

@@ -194,7 +194,7 @@ pub fn simulate_mechanism(
 
 fn write(dir: &Path, name: &str, text: &str) -> Result<()> {
     let path = dir.join(name);
-    std::fs::write(&path, text).map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))
+    std::fs::write(&path, text).map_err(|e| PianoError::io(&path, "write", e))
 }
 
 fn write_json(dir: &Path, name: &str, value: &Value) -> Result<()> {

@@ -500,7 +500,7 @@ impl ActionParams {
     /// the field.
     pub fn load(path: &std::path::Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| PianoError::file(path, format!("cannot read the parameter file: {e}")))?;
+            .map_err(|e| PianoError::io(path, "read the parameter file", e))?;
         Self::from_toml_str(&text).map_err(|e| e.in_file(path))
     }
 

@@ -493,8 +493,7 @@ pub(crate) fn write_replay_files(
     }
     let write = |name: &str, text: &str| {
         let path = dir.join(name);
-        std::fs::write(&path, text)
-            .map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))
+        std::fs::write(&path, text).map_err(|e| PianoError::io(&path, "write", e))
     };
     write("poses.csv", &poses)?;
     write("series.csv", &series)?;
@@ -745,8 +744,7 @@ fn read_measured(dir: &Path, series: &[(&str, &str, Vec<f64>)]) -> Result<Value>
     if !path.exists() {
         return Ok(Value::Null);
     }
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| PianoError::file(&path, format!("cannot read: {e}")))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| PianoError::io(&path, "read", e))?;
     let known: Vec<&str> = series.iter().map(|s| s.0).collect();
     let measured = crate::measured::parse_measured(&text, &path, &known)?;
     Ok(measured
@@ -849,7 +847,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, replace: bool) -> Result<()> {
         }
     }
     let html = report_html(dirs)?;
-    std::fs::write(out, html).map_err(|e| PianoError::file(out, format!("cannot write: {e}")))
+    std::fs::write(out, html).map_err(|e| PianoError::io(out, "write", e))
 }
 
 #[cfg(test)]

@@ -520,7 +520,7 @@ impl Scenario {
     /// the scenario's folder) into its points. Errors name the file, the line and the field.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| PianoError::file(path, format!("cannot read the scenario: {e}")))?;
+            .map_err(|e| PianoError::io(path, "read the scenario", e))?;
         let mut scenario = Self::from_toml_str(&text).map_err(|e| e.in_file(path))?;
         if let Some(file) = &scenario.mechanism {
             let full = path.parent().unwrap_or(Path::new(".")).join(file);
@@ -668,7 +668,7 @@ impl Scenario {
 /// Writes `text` to `dir/name`; the error names the file.
 fn write_file(dir: &Path, name: &str, text: &str) -> Result<()> {
     let path = dir.join(name);
-    std::fs::write(&path, text).map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))
+    std::fs::write(&path, text).map_err(|e| PianoError::io(&path, "write", e))
 }
 
 /// Writes `value` as pretty JSON to `dir/name`.
@@ -713,8 +713,7 @@ fn run_outputs_in(dir: &Path) -> Result<Vec<std::path::PathBuf>> {
             "is a file, not a folder: choose another --out",
         ));
     }
-    let entries = std::fs::read_dir(dir)
-        .map_err(|e| PianoError::file(dir, format!("cannot list the folder: {e}")))?;
+    let entries = std::fs::read_dir(dir).map_err(|e| PianoError::io(dir, "list the folder", e))?;
     let mut found = Vec::new();
     for entry in entries.flatten() {
         if entry.file_name().to_str().is_some_and(is_run_output) {
@@ -775,11 +774,9 @@ pub fn check_run_dir(dir: &Path, replace: bool) -> Result<()> {
 pub fn prepare_run_dir(dir: &Path, replace: bool) -> Result<()> {
     check_run_dir(dir, replace)?;
     for path in run_outputs_in(dir)? {
-        std::fs::remove_file(&path)
-            .map_err(|e| PianoError::file(&path, format!("cannot remove: {e}")))?;
+        std::fs::remove_file(&path).map_err(|e| PianoError::io(&path, "remove", e))?;
     }
-    std::fs::create_dir_all(dir)
-        .map_err(|e| PianoError::file(dir, format!("cannot create the folder: {e}")))
+    std::fs::create_dir_all(dir).map_err(|e| PianoError::io(dir, "create the folder", e))
 }
 
 /// Creates the run directory and writes `run.json` (scenario, parameters, version); a

@@ -138,8 +138,7 @@ pub fn write_wav(path: &Path, force: &[f64]) -> Result<SoundLevels> {
     bytes.extend_from_slice(b"data");
     bytes.extend_from_slice(&data_len.to_le_bytes());
     bytes.extend_from_slice(&data);
-    std::fs::write(path, &bytes)
-        .map_err(|e| PianoError::file(path, format!("cannot write: {e}")))?;
+    std::fs::write(path, &bytes).map_err(|e| PianoError::io(path, "write", e))?;
     let peak_n = force.iter().fold(0.0f64, |m, f| m.max(f.abs()));
     let start = force.iter().position(|f| *f != 0.0).unwrap_or(0);
     let attack = &force[start..(start + (0.1 * fs) as usize).min(force.len())];

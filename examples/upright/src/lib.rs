@@ -17,11 +17,19 @@
 //! jack top (a 2 mm circle) against the notch's **seat** (the butt felt, which it lifts) and
 //! against its **wall** (on the string side, which the jack spring presses it into). At
 //! let-off the toe meets the button, the jack turns toward the player and its top slides
-//! along the seat and off its lip (2 mm): the hammer flies free.
+//! along the seat and off its lip (2 mm): the hammer flies free. In front of the lip the
+//! butt's **face** rises: the escaped top leans on it and gets back into the notch only when
+//! the notch comes down to it. At rest the top sits 0.5 mm under the seat (the **lost
+//! motion**), so it can swing back in once the key is up; the dip, the let-off button and
+//! the back-check are regulated for it (see the constants).
+//!
+//! [`repetition`] compares its repetition with the grand's double escapement.
 //!
 //! Not modelled: the damper (lever, spoon, spring: optional for hammer velocity, layout
 //! §2.2), the jack-slap rail (a joint stop on the jack stands in for it), balance-rail
 //! lift-off. The string is the grand's C4 unison (an upright's is shorter \[M\]).
+
+pub mod repetition;
 
 use piano_action::ActionParams;
 use piano_action::mechanism::{
@@ -53,6 +61,42 @@ impl Frame {
     }
 }
 
+/// The jack's frame: at its pin, unturned.
+const JACK_FRAME: Frame = Frame {
+    origin: J,
+    angle: 0.0,
+};
+
+/// The hammer's frame: x along the shank (e1), y = e1 turned a quarter counter-clockwise
+/// (= −e2: the layout's hammer axes are left-handed).
+fn hammer_frame() -> Frame {
+    Frame {
+        origin: H,
+        angle: E1[1].atan2(E1[0]),
+    }
+}
+
+/// How far (mm) the back-check face is set back along its normal (0.112, 0.994) from the
+/// layout's (§4.2 \[D\], 15 mm check at 10.0 mm dip), as a technician bends the wire for
+/// the deeper dip: a slow press is checked about 15 mm from the string again \[D\].
+const BACKCHECK_SET_BACK_MM: f64 = 0.6;
+
+/// A back-check point of the layout (mm, at rest), set back by [`BACKCHECK_SET_BACK_MM`].
+fn backcheck_regulated(p: P) -> P {
+    [
+        p[0] - BACKCHECK_SET_BACK_MM * 0.112,
+        p[1] - BACKCHECK_SET_BACK_MM * 0.994,
+    ]
+}
+
+/// The jack top's centre at rest, N = J + 68.38 a0, a0 = (0.1506, 0.9886) \[D\] (a 2 mm
+/// circle).
+const JACK_TOP: P = [104.30, 131.36];
+/// The notch's lip (mm, at rest): the seat's end on the player's side \[D\].
+const LIP: P = [102.3, SEAT_Y];
+/// The seat's other end, at the wall (mm, at rest) \[D\].
+const SEAT_AT_WALL: P = [106.3, SEAT_Y];
+
 /// The world frame.
 const WORLD: Frame = Frame {
     origin: [0.0, 0.0],
@@ -73,6 +117,28 @@ const E1: P = [-0.3938, 0.9192];
 const E2: P = [0.9192, 0.3938];
 /// The string plane x (mm) \[S\]: H_x + 53.95 (butt centre → strings ≈ 2 1/8").
 const STRING_X: f64 = 173.25;
+/// Lost motion at the jack top (mm): the gap between the jack top and the butt's seat at
+/// rest, with the hammer on its rail. The layout's nominal zero (§4.4) leaves an escaped
+/// jack no way back in: its pin is below and the top leans 8.7° toward the strings, so the
+/// top rises 0.28 mm on its arc as it swings back to the lip \[D\]. In practice 0.2–0.5 mm
+/// at the jack top \[M\], "just enough to let the jack slip back under the butt" (Page,
+/// MMD 2003.01.20.11 \[V\]): the upper end, which clears the arc.
+pub const LOST_MOTION_MM: f64 = 0.5;
+/// The notch's seat height at rest (mm): the jack top's (133.36, layout §4.2 \[D\]) plus
+/// the lost motion.
+const SEAT_Y: f64 = 133.36 + LOST_MOTION_MM;
+/// Key dip at the front (mm): the deeper end of the usual 10.0–10.5 mm (layout §3 \[V\]),
+/// which the lost motion needs to leave aftertouch \[D\].
+pub const DIP_MM: f64 = 10.5;
+/// The front punching's top (mm): the key's contact point, 215 mm before the balance pin
+/// (§4.2 \[V/D\]), goes down `DIP_MM` × 215/235.
+const FRONT_RAIL_Y: f64 = -DIP_MM * 215.0 / 235.0;
+/// The let-off button's underside (mm), regulated as a technician does, on a slow press:
+/// the layout's y = 69.17 (§4.2 \[D\]) raised by what the toe rises while the wippen takes
+/// up the lost motion (toe 48.19 mm, jack top 27.70 mm before the wippen pin in x: 0.87 mm
+/// \[D\]), then lowered 0.40 mm so that a slow press (0.8 N) lets off about 4 mm from the
+/// string as the layout's rigid pose did (3.8 mm; 3.9 mm before; 2.1 mm at 10 N) \[D\].
+const BUTTON_Y: f64 = 69.17 + LOST_MOTION_MM * (132.00 - 83.81) / (132.00 - 104.30) - 0.40;
 
 /// A point given in the layout's hammer coordinates (mm along e1 and e2 from H) in the
 /// world (mm).
@@ -175,20 +241,10 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
         origin: W,
         angle: 0.0,
     };
-    let jack = Frame {
-        origin: J,
-        angle: 0.0,
-    };
-    // The hammer's frame: x along the shank (e1), y = e1 turned a quarter counter-clockwise
-    // (= −e2: the layout's hammer axes are left-handed).
-    let hammer = Frame {
-        origin: H,
-        angle: E1[1].atan2(E1[0]),
-    };
+    let jack = JACK_FRAME;
+    let hammer = hammer_frame();
     let hw = |u: f64, v: f64| hammer_world(u, v);
-
-    // Jack top N = J + 68.38 a0, a0 = (0.1506, 0.9886) [D].
-    let n = [104.30, 131.36];
+    let n = JACK_TOP;
     let bodies = vec![
         Body {
             name: "key".into(),
@@ -267,7 +323,8 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
                 outline(
                     &wippen,
                     "back-check",
-                    &[[67.0, 124.0], [81.0, 122.5], [80.5, 128.8], [68.6, 130.2]],
+                    &[[67.0, 124.0], [81.0, 122.5], [80.5, 128.8], [68.6, 130.2]]
+                        .map(backcheck_regulated),
                     12.0,
                     "#a88d6c",
                 ),
@@ -422,8 +479,12 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
     let contacts = vec![
         contact(
             "front_rail",
-            "front punching, top y = −9.15 mm (10.0 mm dip) [D]; k 1.3e7 [D/M]",
-            ground(vec![segment(&WORLD, [-225.0, -9.15], [-205.0, -9.15])]),
+            "front punching, top y = −9.61 mm (10.5 mm dip [V/D]); k 1.3e7 [D/M]",
+            ground(vec![segment(
+                &WORLD,
+                [-225.0, FRONT_RAIL_Y],
+                [-205.0, FRONT_RAIL_Y],
+            )]),
             side("key", vec![circle(&key, [-215.0, 2.0], 2.0)]),
             felt(1.3e7, 0.4),
             None,
@@ -449,11 +510,9 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
         ),
         contact(
             "jack_seat",
-            "the butt felt the jack top lifts, ending at the lip (102.3) [D]; buckskin k 5e7 [D/M]",
-            side(
-                "hammer",
-                vec![segment(&hammer, [106.3, 133.36], [102.3, 133.36])],
-            ),
+            "the butt felt the jack top lifts, ending at the lip (102.3) [D], 0.5 mm over the \
+             jack top at rest (lost motion [M/D]); buckskin k 5e7 [D/M]",
+            side("hammer", vec![segment(&hammer, SEAT_AT_WALL, LIP)]),
             side("jack", vec![circle(&jack, n, 2.0)]),
             felt(5e7, 0.4),
             coulomb(0.15),
@@ -463,7 +522,25 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
             "the notch wall on the string side of the jack top [D]",
             side(
                 "hammer",
-                vec![segment(&hammer, [106.3, 128.36], [106.3, 133.36])],
+                vec![segment(&hammer, [106.3, SEAT_Y - 5.0], [106.3, SEAT_Y])],
+            ),
+            side("jack", vec![circle(&jack, n, 2.0)]),
+            felt(5e7, 0.4),
+            coulomb(0.15),
+        ),
+        contact(
+            "butt_face",
+            "the butt's face rising from the lip on the player's side: the escaped jack top \
+             leans on it until the notch comes back down to it [M]; buckskin as the seat. It \
+             starts 1 mm over the lip, so the lip's corner is the seat's alone (the 2 mm top \
+             cannot pass the gap)",
+            side(
+                "hammer",
+                vec![segment(
+                    &hammer,
+                    [102.3, SEAT_Y + 7.0],
+                    [102.3, SEAT_Y + 1.0],
+                )],
             ),
             side("jack", vec![circle(&jack, n, 2.0)]),
             felt(5e7, 0.4),
@@ -471,8 +548,9 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
         ),
         contact(
             "let_off_button",
-            "button underside y = 69.17, 3.88 mm over the toe [D]; k 2e7 [D/M]",
-            ground(vec![segment(&WORLD, [92.0, 69.17], [76.0, 69.17])]),
+            "button underside y = 69.64: the layout's 69.17 [D] regulated for the lost motion \
+             [D], 4.35 mm over the toe; k 2e7 [D/M]",
+            ground(vec![segment(&WORLD, [92.0, BUTTON_Y], [76.0, BUTTON_Y])]),
             side("jack", vec![circle(&jack, [83.81, 63.29], 2.0)]),
             felt(2e7, 0.4),
             coulomb(0.25),
@@ -491,10 +569,15 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
         ),
         contact(
             "backcheck",
-            "catcher r 5 at body (14, −30) on the back-check face [D/M]; k 5e6, e 0.1 [D/M]",
+            "catcher r 5 at body (14, −30) on the back-check face [D/M], the face set 0.6 mm \
+             lower than the layout's for the 10.5 mm dip [D]; k 5e6, e 0.1 [D/M]",
             side(
                 "wippen",
-                vec![segment(&wippen, [68.6, 130.19], [80.5, 128.85])],
+                vec![segment(
+                    &wippen,
+                    backcheck_regulated([68.6, 130.19]),
+                    backcheck_regulated([80.5, 128.85]),
+                )],
             ),
             side("hammer", vec![circle(&hammer, hw(14.0, -30.0), 5.0)]),
             felt(5e6, 0.1),
@@ -544,7 +627,12 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
             outline(
                 &WORLD,
                 "let-off rail",
-                &[[72.0, 69.17], [95.0, 69.17], [95.0, 76.0], [72.0, 76.0]],
+                &[
+                    [72.0, BUTTON_Y],
+                    [95.0, BUTTON_Y],
+                    [95.0, 76.0],
+                    [72.0, 76.0],
+                ],
                 20.0,
                 "#8aa37a",
             ),
@@ -674,4 +762,31 @@ pub fn crown_to_string_mm(
     x: &[f64],
 ) -> Result<f64, piano_action::PianoError> {
     Ok((STRING_X_M - marker_position(mechanism, built, "hammer_crown", t, x)?[0]) * 1e3)
+}
+
+/// How far (mm) the jack top's centre has come back past the notch's lip, along the seat
+/// toward the wall, at `(t, x)` of `built` (the system built from [`upright_mechanism`]):
+/// 2 mm when seated against the wall, 0 at the lip, negative when the jack has escaped
+/// toward the player. Past about 1 mm (half the top's radius) the jack is back under the
+/// butt: a press lifts the hammer again.
+pub fn jack_top_past_lip_mm(
+    built: &piano_action::mechanism::Built,
+    t: f64,
+    x: &[f64],
+) -> Result<f64, piano_action::PianoError> {
+    let model = built.system.model();
+    let mut ws = built.system.workspace();
+    let ctx = built.system.kinematics(&mut ws, t, x)?;
+    let at = |body: &str, p: P| -> Result<[f64; 2], piano_action::PianoError> {
+        let frame = model.frame_id(body)?;
+        let (b, point) = mbs_core::frame_point(model, frame, p);
+        Ok(ctx.point_position(b, point))
+    };
+    let hammer = hammer_frame();
+    let top = at("jack", JACK_FRAME.local(JACK_TOP))?;
+    let lip = at("hammer", hammer.local(LIP))?;
+    let wall = at("hammer", hammer.local(SEAT_AT_WALL))?;
+    let (ux, uy) = (wall[0] - lip[0], wall[1] - lip[1]);
+    let len = ux.hypot(uy);
+    Ok(((top[0] - lip[0]) * ux + (top[1] - lip[1]) * uy) / len * 1e3)
 }

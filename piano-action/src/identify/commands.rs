@@ -81,11 +81,10 @@ pub fn synth_to_disk(
     let (dataset, runs, truth_record) = synthesize(params, options)?;
     dataset
         .write(out, &runs)
-        .map_err(|e| PianoError::file(out, format!("cannot write the dataset: {e}")))?;
+        .map_err(|e| PianoError::io(out, "write the dataset", e))?;
     let text = serde_json::to_string_pretty(&truth_record)
         .map_err(|e| PianoError::file(truth, format!("cannot encode: {e}")))?;
-    std::fs::write(truth, text + "\n")
-        .map_err(|e| PianoError::file(truth, format!("cannot write: {e}")))?;
+    std::fs::write(truth, text + "\n").map_err(|e| PianoError::io(truth, "write", e))?;
     Ok(())
 }
 
@@ -180,7 +179,7 @@ pub fn diagnose_to_disk(
         let text = corrected_params(source, &d, dir)?;
         // The written file must read back and carry what the diagnosis found.
         ActionParams::from_toml_str(&text)?;
-        std::fs::write(p, text).map_err(|e| PianoError::file(p, format!("cannot write: {e}")))?;
+        std::fs::write(p, text).map_err(|e| PianoError::io(p, "write", e))?;
         written.push(p.to_path_buf());
     }
     Ok(Outcome {

@@ -36,8 +36,7 @@ fn generator_mark(name: &str) -> String {
 /// Writes the three pages of `d` into `dir` (created if missing); returns their paths.
 pub fn write_pages(d: &Diagnosis, dataset: &Path, dir: &Path, force: bool) -> Result<Vec<PathBuf>> {
     check_out_dir(dir, force)?;
-    std::fs::create_dir_all(dir)
-        .map_err(|e| PianoError::file(dir, format!("cannot create the folder: {e}")))?;
+    std::fs::create_dir_all(dir).map_err(|e| PianoError::io(dir, "create the folder", e))?;
     let mut json = serde_json::to_value(d)
         .map_err(|e| PianoError::file(dir, format!("cannot encode the report: {e}")))?;
     if let Some(map) = json.as_object_mut() {
@@ -53,8 +52,7 @@ pub fn write_pages(d: &Diagnosis, dataset: &Path, dir: &Path, force: bool) -> Re
         (FILES[2], html(d, dataset)),
     ] {
         let path = dir.join(name);
-        std::fs::write(&path, text)
-            .map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))?;
+        std::fs::write(&path, text).map_err(|e| PianoError::io(&path, "write", e))?;
         written.push(path);
     }
     Ok(written)

@@ -80,13 +80,11 @@ fn generator_mark(name: &str) -> String {
 /// after the same checks as [`check_out_dir`]; returns the files written.
 pub fn write_pages(v: &Validation, dir: &Path, force: bool) -> Result<Vec<PathBuf>> {
     check_out_dir(dir, force)?;
-    std::fs::create_dir_all(dir)
-        .map_err(|e| PianoError::file(dir, format!("cannot create the folder: {e}")))?;
+    std::fs::create_dir_all(dir).map_err(|e| PianoError::io(dir, "create the folder", e))?;
     let mut written = Vec::new();
     for (name, text) in [(FILES[0], markdown(v)), (FILES[1], html(v))] {
         let path = dir.join(name);
-        std::fs::write(&path, text)
-            .map_err(|e| PianoError::file(&path, format!("cannot write: {e}")))?;
+        std::fs::write(&path, text).map_err(|e| PianoError::io(&path, "write", e))?;
         written.push(path);
     }
     Ok(written)
