@@ -213,6 +213,10 @@ mod tests {
 
 /// A piecewise-linear motion whose corners are rounded by parabolic blends (C¹, finite
 /// acceleration), constant before the first and after the last point.
+///
+/// The first and last points are corners too: a motion that leaves its first point on a
+/// slope does not pass through it: it is off by slope × τ / 4 there. Start with a short
+/// flat segment to start exactly at the first value.
 #[derive(Clone, Debug)]
 pub struct BlendedLinear {
     t: Vec<f64>,
