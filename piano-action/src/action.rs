@@ -172,11 +172,7 @@ impl Action {
     /// Adds a vertical force pressing down on the key front (the finger point), its
     /// magnitude (N) a function of time.
     pub fn add_key_force(&mut self, magnitude: impl TimeFunction + 'static) -> Result<()> {
-        let k = &self.params.key;
-        let at = [
-            (k.finger_mm[0] - k.pivot_mm[0]) * 1e-3,
-            (k.finger_mm[1] - k.pivot_mm[1]) * 1e-3,
-        ];
+        let at = crate::key::KeyGeometry::of(&self.params.key).finger_m();
         let model = self.system.model().clone();
         let finger = AppliedLoad::force(
             &model,

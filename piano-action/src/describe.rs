@@ -513,7 +513,7 @@ pub fn grand_mechanism(
                 magnitude: -pr.mass_kg * -GRAVITY_M_S2,
             });
         }
-        let kf = [k.finger_mm[0] - kp[0], k.finger_mm[1] - kp[1]];
+        let kf = crate::key::KeyGeometry::of(k).finger_mm;
         let mut presser_key = pair(
             "presser_key",
             on(
@@ -560,7 +560,7 @@ pub fn grand_mechanism(
         },
     }];
 
-    let kf = [k.finger_mm[0] - kp[0], k.finger_mm[1] - kp[1]];
+    let kf = crate::key::KeyGeometry::of(k).finger_mm;
     let inputs = vec![Input {
         name: "finger".into(),
         note: "the key front where a finger presses (force positive down)".into(),

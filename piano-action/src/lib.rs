@@ -27,6 +27,7 @@ mod error;
 pub mod fuzzing;
 pub mod geometry_check;
 pub mod identify;
+pub mod key;
 pub mod measured;
 pub mod mechanism_run;
 pub mod param_paths;

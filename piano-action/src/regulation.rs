@@ -10,7 +10,7 @@ use serde::Serialize;
 use crate::action::{Action, ModelKind};
 use crate::error::Result;
 use crate::params::ActionParams;
-use crate::simulate::{Finger, Input, TouchStyle};
+use crate::simulate::{Finger, Input, TouchStyle, key_depth_mm};
 
 /// The regulation measured on an action (mm), as `piano regulate --json` reports it.
 /// Quantities a model does not have (let-off without a jack, drop without a repetition
@@ -32,16 +32,6 @@ pub struct Regulation {
     pub check_mm: Option<f64>,
     /// Key-front travel left after let-off.
     pub aftertouch_mm: Option<f64>,
-}
-
-/// Key-front depth (mm) for key angle `q` (finger point rotating about the pivot).
-fn key_depth_mm(params: &ActionParams, q: f64) -> f64 {
-    let f = [
-        params.key.finger_mm[0] - params.key.pivot_mm[0],
-        params.key.finger_mm[1] - params.key.pivot_mm[1],
-    ];
-    let (s, c) = q.sin_cos();
-    f[1] - (s * f[0] + c * f[1])
 }
 
 /// Runs `action` under a key-front force following `table` ((time, newtons) points).

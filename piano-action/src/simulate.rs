@@ -274,17 +274,7 @@ fn check_table(
 
 /// The key angle (rad) that puts the finger point `depth_mm` below its layout position.
 pub fn key_angle_for_depth(params: &ActionParams, depth_mm: f64) -> f64 {
-    let fx = params.key.finger_mm[0] - params.key.pivot_mm[0];
-    let fy = params.key.finger_mm[1] - params.key.pivot_mm[1];
-    // depth(q) = fy − (fx sin q + fy cos q); Newton from the small-angle guess.
-    let mut q = depth_mm / (fx * fx + fy * fy).sqrt();
-    for _ in 0..6 {
-        let (s, c) = q.sin_cos();
-        let f = key_depth_mm(params, q) - depth_mm;
-        let df = -(fx * c - fy * s);
-        q -= f / df;
-    }
-    q
+    crate::key::KeyGeometry::of(&params.key).angle_for_depth(depth_mm)
 }
 
 /// A piano event, in time order.
@@ -397,10 +387,7 @@ fn key_start_time(
 
 /// Key-front depth (mm, down positive) at key angle `q`.
 pub fn key_depth_mm(params: &ActionParams, q: f64) -> f64 {
-    let fx = params.key.finger_mm[0] - params.key.pivot_mm[0];
-    let fy = params.key.finger_mm[1] - params.key.pivot_mm[1];
-    let (s, c) = q.sin_cos();
-    fy - (fx * s + fy * c)
+    crate::key::KeyGeometry::of(&params.key).depth_mm(q)
 }
 
 /// Contacts whose onset and release are piano events.
@@ -594,11 +581,7 @@ pub fn simulate_observed(
             action.system.derivative(&mut ws, t, x, &mut dx)?;
             // The torque the drive applies about the balance pivot, as a vertical force at
             // the finger point (the lever arm is its horizontal distance).
-            let q = x[key];
-            let f = &params.key.finger_mm;
-            let arm = ((f[0] - params.key.pivot_mm[0]) * q.cos()
-                - (f[1] - params.key.pivot_mm[1]) * q.sin())
-                * 1e-3;
+            let arm = crate::key::KeyGeometry::of(&params.key).arm_m(x[key]);
             key_drive_force_n.push(-ws.drive_forces()[key] / arm);
         }
     }

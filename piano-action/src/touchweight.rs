@@ -36,7 +36,7 @@ fn slow_move_force_gf(params: &ActionParams, kind: ModelKind, q0: f64, q1: f64) 
     let sol = action.integrate(&x0, 2.2, 2e-3, Some(0.01))?;
     let key = action.system.model().coordinate_id("key")?;
     let k = &params.key;
-    let arm = ((k.finger_mm[0] - k.pivot_mm[0]) * 1e-3).abs();
+    let arm = crate::key::KeyGeometry::of(k).arm_m(0.0).abs();
     let mut ws = action.system.workspace();
     let mut xdot = vec![0.0; action.system.state_len()];
     let (mut sum, mut count) = (0.0, 0.0f64);
@@ -58,7 +58,7 @@ fn slow_move_force_gf(params: &ActionParams, kind: ModelKind, q0: f64, q1: f64) 
 /// (before let-off) and back.
 pub fn measure(params: &ActionParams, kind: ModelKind) -> Result<TouchWeight> {
     let k = &params.key;
-    let arm = ((k.finger_mm[0] - k.pivot_mm[0]) * 1e-3).abs();
+    let arm = crate::key::KeyGeometry::of(k).arm_m(0.0).abs();
     let q = 6e-3 / arm;
     let down = slow_move_force_gf(params, kind, 0.0, q)?;
     let up = slow_move_force_gf(params, kind, q, 0.0)?;

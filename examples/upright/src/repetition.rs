@@ -18,7 +18,8 @@
 //! `jack_reset` event.
 
 use mbs_core::time_function::BlendedLinear;
-use piano_action::mechanism::{BodyPoint, Built, Input, InputKind, Mechanism};
+use piano_action::key::KeyGeometry;
+use piano_action::mechanism::{Built, Input, InputKind, Mechanism};
 use piano_action::mechanism_run::{settle, simulate_mechanism};
 use piano_action::{ActionParams, ModelKind, PianoError, integrate_system};
 
@@ -70,34 +71,6 @@ fn coordinates(built: &Built, t: f64, x: &[f64]) -> Result<Vec<f64>> {
     Ok(built.system.kinematics(&mut ws, t, x)?.q.to_vec())
 }
 
-/// The key's finger point: the description's `finger` input.
-fn finger(m: &Mechanism) -> Result<&BodyPoint> {
-    m.inputs
-        .iter()
-        .find(|i| i.name == "finger")
-        .map(|i| &i.at)
-        .ok_or_else(|| PianoError::option("inputs", "the description has no 'finger' input"))
-}
-
-/// The height (m) of the key's finger point `p` (key frame) at key angle `q`, the key
-/// turning about its pivot from the frame angle `a`.
-fn front_height(p: [f64; 2], a: f64, q: f64) -> f64 {
-    let (s, c) = (a + q).sin_cos();
-    p[0] * s + p[1] * c
-}
-
-/// The key angle at which the front is `depth` (m) below where it is at `q0` (Newton).
-fn key_angle_for_depth(p: [f64; 2], a: f64, q0: f64, depth: f64) -> f64 {
-    let target = front_height(p, a, q0) - depth;
-    let mut q = q0;
-    for _ in 0..20 {
-        let (s, c) = (a + q).sin_cos();
-        let slope = p[0] * c - p[1] * s;
-        q -= (front_height(p, a, q) - target) / slope;
-    }
-    q
-}
-
 /// The key-front rise to repeat, for one action and one rise speed.
 #[derive(Clone, Copy, Debug)]
 pub struct KeyRise {
@@ -126,17 +99,16 @@ pub fn key_rise_to_repeat(action: Action, speed_mm_s: f64) -> Result<KeyRise> {
         1e-3,
         &mut |_| {},
     )?;
-    let front = finger(&m)?.clone();
-    let key_joint = m
-        .bodies
+    let key_lever = KeyGeometry::from_mechanism(&m, "finger")?;
+    let front = m
+        .inputs
         .iter()
-        .find(|b| b.name == front.body)
-        .map(|b| b.joint.angle)
-        .unwrap_or(0.0);
+        .find(|i| i.name == "finger")
+        .map(|i| i.at.clone())
+        .ok_or_else(|| PianoError::option("inputs", "the description has no 'finger' input"))?;
     let key = held.built.system.model().coordinate_id(&front.body)?;
     let q0 = held.x0[key];
-    let depth = front_height(front.point, key_joint, q0)
-        - front_height(front.point, key_joint, held.solution.y_final[key]);
+    let depth_mm = key_lever.height_mm(q0) - key_lever.height_mm(held.solution.y_final[key]);
 
     m.inputs.push(Input {
         name: "key motion".into(),
@@ -145,8 +117,8 @@ pub fn key_rise_to_repeat(action: Action, speed_mm_s: f64) -> Result<KeyRise> {
         at: front.clone(),
         direction: [0.0, -1.0],
     });
-    let q_bottom = key_angle_for_depth(front.point, key_joint, q0, depth);
-    let up_s = depth * 1e3 / speed_mm_s;
+    let q_bottom = key_lever.angle_below(q0, depth_mm);
+    let up_s = depth_mm / speed_mm_s;
     let drive = BlendedLinear::new(
         &[
             (0.0, q0),
@@ -184,11 +156,7 @@ pub fn key_rise_to_repeat(action: Action, speed_mm_s: f64) -> Result<KeyRise> {
             escaped = !back;
         } else if escaped && back {
             let q = coordinates(&built, t, x)?;
-            rise = Some(
-                (front_height(front.point, key_joint, q[key])
-                    - front_height(front.point, key_joint, q_bottom))
-                    * 1e3,
-            );
+            rise = Some(key_lever.height_mm(q[key]) - key_lever.height_mm(q_bottom));
             break;
         }
     }
@@ -199,7 +167,7 @@ pub fn key_rise_to_repeat(action: Action, speed_mm_s: f64) -> Result<KeyRise> {
         ));
     }
     Ok(KeyRise {
-        depth_mm: depth * 1e3,
+        depth_mm,
         rise_mm: rise,
     })
 }

@@ -269,8 +269,7 @@ fn ratio_rows(params: &ActionParams, kind: ModelKind) -> Vec<Row> {
             let model = action.system.model();
             let (key, hammer) = (model.coordinate_id("key")?, model.coordinate_id("hammer")?);
             let k = &params.key;
-            let finger_radius =
-                (k.finger_mm[0] - k.pivot_mm[0]).hypot(k.finger_mm[1] - k.pivot_mm[1]) * 1e-3;
+            let finger_radius = crate::key::KeyGeometry::of(k).radius_mm() * 1e-3;
             let radius = strike_radius(params);
             let sol = &run.solution;
             let at = |frac: f64| {
