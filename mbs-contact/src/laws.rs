@@ -821,8 +821,12 @@ impl Stribeck {
 
 impl TangentialLaw for Stribeck {
     fn force(&self, normal: f64, slip: f64) -> f64 {
-        let s = slip / self.v_stribeck;
-        let mu = self.mu_kinetic + (self.mu_static - self.mu_kinetic) * (-s * s).exp();
+        let mu = mbs_core::elements::stribeck_level(
+            self.mu_kinetic,
+            self.mu_static,
+            self.v_stribeck,
+            slip,
+        );
         -normal.max(0.0) * mu * (slip / self.v_eps).tanh() - self.viscous * slip
     }
 }

@@ -407,6 +407,26 @@ impl ForceElement for Cord {
     }
 }
 
+/// The Stribeck curve, the one friction level every friction law here uses: the breakaway
+/// level `breakaway` at rest decays to the kinetic level `kinetic` over the speed scale
+/// `v_stribeck` as `kinetic + (breakaway − kinetic) e^{−(v/v_s)²}` (the Gaussian form of
+/// Armstrong-Hélouvry, Dupont & Canudas de Wit, Automatica 30(7):1083, 1994). Pivot
+/// friction (torques), contact friction (coefficients) and the identified flange effects
+/// (an extra level over zero) call it.
+///
+/// ```
+/// use mbs_core::elements::stribeck_level;
+/// // The breakaway level at rest, 1/e of the way down at the Stribeck speed, kinetic beyond.
+/// assert_eq!(stribeck_level(0.2, 0.5, 0.1, 0.0), 0.5);
+/// let e = std::f64::consts::E;
+/// assert!((stribeck_level(0.2, 0.5, 0.1, -0.1) - (0.2 + 0.3 / e)).abs() < 1e-15);
+/// assert!((stribeck_level(0.2, 0.5, 0.1, 1.0) - 0.2).abs() < 1e-12);
+/// ```
+pub fn stribeck_level(kinetic: f64, breakaway: f64, v_stribeck: f64, v: f64) -> f64 {
+    let r = v / v_stribeck;
+    kinetic + (breakaway - kinetic) * (-r * r).exp()
+}
+
 /// The optional Stribeck part of pivot friction: the breakaway torque `static_torque` decays
 /// to the Coulomb level over the speed scale `velocity` as `exp(−(v / velocity)²)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -546,10 +566,7 @@ impl PivotFriction {
         let law = &self.law;
         let level = match law.stribeck {
             None => law.coulomb,
-            Some(s) => {
-                let r = v / s.velocity;
-                law.coulomb + (s.static_torque - law.coulomb) * (-r * r).exp()
-            }
+            Some(s) => stribeck_level(law.coulomb, s.static_torque, s.velocity, v),
         };
         -(level * (v / law.regularization).tanh() + law.viscous * v)
     }

@@ -251,8 +251,7 @@ impl FlangeEffects {
     /// with the pin's load `pin_force_n`.
     pub fn friction_level(&self, omega: f64, pin_force_n: f64) -> f64 {
         let stribeck = if self.stribeck_n_m > 0.0 {
-            let r = omega / self.stribeck_rad_s;
-            self.stribeck_n_m * (-r * r).exp()
+            mbs_core::elements::stribeck_level(0.0, self.stribeck_n_m, self.stribeck_rad_s, omega)
         } else {
             0.0
         };
