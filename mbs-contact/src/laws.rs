@@ -45,18 +45,16 @@ pub trait TangentialLaw: Send + Sync + std::fmt::Debug {
 
 /// Checks a parameter is finite (and positive or non-negative), naming it.
 pub(crate) fn check(law: &str, field: &str, value: f64, positive: bool) -> Result<f64> {
-    let ok = value.is_finite() && if positive { value > 0.0 } else { value >= 0.0 };
-    if ok {
-        Ok(value)
+    use mbs_core::check::{Bound, check_value};
+    let bound = if positive {
+        Bound::Positive
     } else {
-        Err(ContactError::InvalidParameter {
-            item: format!("{law}.{field}"),
-            message: format!(
-                "must be {} and finite, got {value}",
-                if positive { "positive" } else { "non-negative" }
-            ),
-        })
-    }
+        Bound::NonNegative
+    };
+    check_value(value, bound).map_err(|message| ContactError::InvalidParameter {
+        item: format!("{law}.{field}"),
+        message,
+    })
 }
 
 /// Checks a parameter lies in `[0, 1)` (or `(0, 1]` when `restitution`), naming it.

@@ -335,37 +335,24 @@ impl Material {
     /// Checks the friction parameters (the normal law was checked when built), naming the
     /// bad field as `<material>.<field>`.
     pub fn validate(&self) -> Result<()> {
-        let bad = |field: &str, message: String| {
-            Err(ContactError::InvalidParameter {
-                item: format!("{}.{field}", self.name),
-                message,
-            })
+        use mbs_core::check::{Bound, check_value};
+        let bad = |field: &str, message: String| ContactError::InvalidParameter {
+            item: format!("{}.{field}", self.name),
+            message,
         };
-        let non_negative = |x: f64| x.is_finite() && x >= 0.0;
-        if !non_negative(self.mu_kinetic) {
-            return bad(
-                "mu_kinetic",
-                format!("must be non-negative and finite, got {}", self.mu_kinetic),
-            );
-        }
-        if !non_negative(self.mu_static) || self.mu_static < self.mu_kinetic {
-            return bad(
+        check_value(self.mu_kinetic, Bound::NonNegative).map_err(|m| bad("mu_kinetic", m))?;
+        check_value(self.mu_static, Bound::NonNegative).map_err(|m| bad("mu_static", m))?;
+        if self.mu_static < self.mu_kinetic {
+            return Err(bad(
                 "mu_static",
                 format!(
-                    "must be finite and at least mu_kinetic ({}), got {}",
+                    "must be at least mu_kinetic ({}), got {}",
                     self.mu_kinetic, self.mu_static
                 ),
-            );
+            ));
         }
-        if !(self.stribeck_velocity.is_finite() && self.stribeck_velocity > 0.0) {
-            return bad(
-                "stribeck_velocity",
-                format!(
-                    "must be positive and finite, got {}",
-                    self.stribeck_velocity
-                ),
-            );
-        }
+        check_value(self.stribeck_velocity, Bound::Positive)
+            .map_err(|m| bad("stribeck_velocity", m))?;
         Ok(())
     }
 

@@ -151,25 +151,13 @@ fn invalid(field: &str, message: String) -> ContactError {
 }
 
 fn positive(field: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(invalid(
-            field,
-            format!("must be positive and finite, got {v}"),
-        ))
-    }
+    mbs_core::check::check_value(v, mbs_core::check::Bound::Positive)
+        .map_err(|message| invalid(field, message))
 }
 
 fn non_negative(field: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(invalid(
-            field,
-            format!("must be non-negative and finite, got {v}"),
-        ))
-    }
+    mbs_core::check::check_value(v, mbs_core::check::Bound::NonNegative)
+        .map_err(|message| invalid(field, message))
 }
 
 impl TautString {

@@ -10,19 +10,16 @@ use crate::model::{BodyId, Model};
 use crate::time_function::TimeFunction;
 
 fn param(item: &str, field: &str, value: f64, nonneg: bool) -> Result<f64> {
-    if !value.is_finite() {
-        return Err(CoreError::InvalidParameter {
-            item: format!("{item}.{field}"),
-            message: format!("must be finite, got {value}"),
-        });
-    }
-    if nonneg && value < 0.0 {
-        return Err(CoreError::InvalidParameter {
-            item: format!("{item}.{field}"),
-            message: format!("must be non-negative, got {value}"),
-        });
-    }
-    Ok(value)
+    use crate::check::{Bound, check_value};
+    let bound = if nonneg {
+        Bound::NonNegative
+    } else {
+        Bound::Finite
+    };
+    check_value(value, bound).map_err(|message| CoreError::InvalidParameter {
+        item: format!("{item}.{field}"),
+        message,
+    })
 }
 
 /// Linear spring–damper parameters shared by the spring elements.

@@ -51,6 +51,7 @@
 mod aba;
 pub mod benchmarks;
 mod builder;
+pub mod check;
 mod crba;
 mod data;
 mod description;

@@ -4,6 +4,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use crate::description::*;
 use crate::error::{MechanismError, Result};
+use mbs_core::check::{Bound, check_value};
 
 fn bad(field: impl Into<String>, message: impl Into<String>) -> MechanismError {
     MechanismError::field(field, message)
@@ -11,27 +12,19 @@ fn bad(field: impl Into<String>, message: impl Into<String>) -> MechanismError {
 
 /// `value` finite, else an error at `field`.
 pub(crate) fn finite(field: &str, value: f64) -> Result<f64> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(bad(field, format!("must be a finite number, got {value}")))
-    }
+    bounded(field, value, Bound::Finite)
 }
 
 pub(crate) fn positive(field: &str, value: f64) -> Result<f64> {
-    if finite(field, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(bad(field, format!("must be positive, got {value}")))
-    }
+    bounded(field, value, Bound::Positive)
 }
 
 pub(crate) fn non_negative(field: &str, value: f64) -> Result<f64> {
-    if finite(field, value)? >= 0.0 {
-        Ok(value)
-    } else {
-        Err(bad(field, format!("must be zero or positive, got {value}")))
-    }
+    bounded(field, value, Bound::NonNegative)
+}
+
+fn bounded(field: &str, value: f64, bound: Bound) -> Result<f64> {
+    check_value(value, bound).map_err(|message| bad(field, message))
 }
 
 pub(crate) fn point(field: &str, p: [f64; 2]) -> Result<()> {
