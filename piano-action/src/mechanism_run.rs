@@ -423,8 +423,9 @@ const CONTACT_PALETTE: [&str; 10] = [
 
 /// The report data of a mechanism run directory, read from its files alone (the
 /// description in `run.json` gives the drawing; nothing is simulated again).
-pub fn report_data(dir: &Path, run_json: &Value) -> Result<Value> {
-    use crate::report::{r, read_json, read_numeric_csv, run_name, series_to_json};
+pub fn report_data(dir: &Path, run_json: &Value) -> Result<crate::report::data::RunData> {
+    use crate::report::data::{Carry, ContactSeries, Plot, RunData, precision};
+    use crate::report::{r, read_json, read_numeric_csv, run_name, to_series};
     let bad = |message: String| PianoError::file(dir, message);
     let mechanism: Mechanism = serde_json::from_value(run_json["mechanism"].clone())
         .map_err(|e| bad(format!("run.json mechanism: {e}")))?;
@@ -436,7 +437,7 @@ pub fn report_data(dir: &Path, run_json: &Value) -> Result<Value> {
 
     let (header, rows) = read_numeric_csv(dir, "poses.csv")?;
     let t: Vec<f64> = rows.iter().map(|row| r(row[0], 6)).collect();
-    let mut carry = serde_json::Map::new();
+    let mut carry = std::collections::BTreeMap::new();
     for b in &mechanism.bodies {
         let col = header
             .iter()
@@ -447,7 +448,11 @@ pub fn report_data(dir: &Path, run_json: &Value) -> Result<Value> {
         };
         carry.insert(
             b.name.clone(),
-            json!({"a": take(0, 6), "x": take(1, 3), "y": take(2, 3)}),
+            Carry {
+                a: take(0, 6),
+                x: take(1, 3),
+                y: take(2, 3),
+            },
         );
     }
 
@@ -459,9 +464,9 @@ pub fn report_data(dir: &Path, run_json: &Value) -> Result<Value> {
             t.len()
         )));
     }
-    let mut contacts = serde_json::Map::new();
-    let mut colors = serde_json::Map::new();
-    let mut labels = serde_json::Map::new();
+    let mut contacts = std::collections::BTreeMap::new();
+    let mut colors = std::collections::BTreeMap::new();
+    let mut labels = std::collections::BTreeMap::new();
     for (k, name) in built.contacts.keys().enumerate() {
         let col = header
             .iter()
@@ -472,13 +477,19 @@ pub fn report_data(dir: &Path, run_json: &Value) -> Result<Value> {
         };
         contacts.insert(
             name.clone(),
-            json!({"f": take(0, 3), "px": take(1, 2), "py": take(2, 2), "nx": take(3, 3), "ny": take(4, 3)}),
+            ContactSeries {
+                f: take(0, 3),
+                px: take(1, 2),
+                py: take(2, 2),
+                nx: take(3, 3),
+                ny: take(4, 3),
+            },
         );
         colors.insert(
             name.clone(),
-            json!(CONTACT_PALETTE[k % CONTACT_PALETTE.len()]),
+            CONTACT_PALETTE[k % CONTACT_PALETTE.len()].to_string(),
         );
-        labels.insert(name.clone(), json!(name.replace('_', " ")));
+        labels.insert(name.clone(), name.replace('_', " "));
     }
 
     let (header, rows) = read_numeric_csv(dir, "series.csv")?;
@@ -523,21 +534,52 @@ pub fn report_data(dir: &Path, run_json: &Value) -> Result<Value> {
                 .collect()
         })
         .unwrap_or_default();
-    Ok(json!({
-        "name": run_name(dir),
-        "title": format!("{}, {}", mechanism.name, crate::report::describe(&scenario.input)),
-        "model": mechanism.name,
-        "scene": scene,
-        "t": t,
-        "carry": carry,
-        "contacts": contacts,
-        "contact_labels": labels,
-        "contact_colors": colors,
-        "series": series_to_json(series),
-        "events": events,
-        "listed_events": if listed.is_empty() { events.clone() } else { Value::from(listed) },
-        "summary": read_json(dir, "summary.json")?,
-        "zoom": {},
-        "measured": Value::Null,
-    }))
+    let summary = read_json(dir, "summary.json")?;
+    // The metrics, as the run's headline.
+    let headline = match summary["metrics"].as_array() {
+        Some(m) if !m.is_empty() => m
+            .iter()
+            .map(|m| {
+                let value = m["value"].as_f64().map_or("–".into(), |v| {
+                    format!("{} {}", precision(v, 4), m["unit"].as_str().unwrap_or(""))
+                });
+                format!("{} {value}", m["name"].as_str().unwrap_or(""))
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
+        _ => "no metrics".into(),
+    };
+    let series = to_series(series);
+    let mut plots = vec![Plot::contact_forces()];
+    if series.iter().any(|s| s.id == "kinetic_mj") {
+        plots.push(Plot::energy("from rest"));
+    }
+    Ok(RunData {
+        name: run_name(dir),
+        title: format!(
+            "{}, {}",
+            mechanism.name,
+            crate::report::describe(&scenario.input)
+        ),
+        model: mechanism.name.clone(),
+        headline,
+        scene,
+        t,
+        carry,
+        contacts,
+        contact_labels: labels,
+        contact_colors: colors,
+        series,
+        plots,
+        listed_events: if listed.is_empty() {
+            events.clone()
+        } else {
+            Value::from(listed)
+        },
+        events,
+        minor_events: "releases and the unnamed contacts' onsets".into(),
+        summary,
+        zoom: json!({}),
+        measured: None,
+    })
 }

@@ -9,9 +9,9 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
-use serde_json::Value;
 
 use crate::error::{PianoError, Result};
+use crate::report::data::RunData;
 
 /// The file format of a figure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,16 +95,8 @@ const LINE_COLORS: [RGBColor; 8] = [
 ];
 
 /// The run's output times (ms).
-fn times_ms(run: &Value) -> Vec<f64> {
-    run["t"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(Value::as_f64)
-                .map(|t| t * 1e3)
-                .collect()
-        })
-        .unwrap_or_default()
+fn times_ms(run: &RunData) -> Vec<f64> {
+    run.t.iter().map(|t| t * 1e3).collect()
 }
 
 /// The most series panels of a mechanism description's figure (the contact forces come
@@ -114,46 +106,31 @@ const MAX_MECHANISM_PANELS: usize = 5;
 /// The panels that apply to the run: hammer angle, hammer speed and key depth where the run
 /// has them, and the contact forces that carry load at some time (a pendulum has neither
 /// key nor contacts).
-fn panels(run: &Value) -> Vec<Panel> {
+fn panels(run: &RunData) -> Vec<Panel> {
     let t = times_ms(run);
     let mut out = Vec::new();
     // A mechanism description's run plots its own series (coordinates, marker speeds); the
     // grand action's, the hammer and the key.
-    let ids: Vec<&str> = if run["summary"]["metrics"].is_array() {
-        run["series"]
-            .as_array()
-            .map(|all| {
-                all.iter()
-                    .filter_map(|s| s["id"].as_str())
-                    .filter(|id| !id.ends_with("_mj"))
-                    .take(MAX_MECHANISM_PANELS)
-                    .collect()
-            })
-            .unwrap_or_default()
+    let ids: Vec<&str> = if run.summary["metrics"].is_array() {
+        run.series
+            .iter()
+            .map(|s| s.id.as_str())
+            .filter(|id| !id.ends_with("_mj"))
+            .take(MAX_MECHANISM_PANELS)
+            .collect()
     } else {
         vec!["hammer_angle_deg", "hammer_speed_m_s", "key_depth_mm"]
     };
     for id in ids {
-        let Some(s) = run["series"]
-            .as_array()
-            .and_then(|all| all.iter().find(|s| s["id"] == id))
-        else {
+        let Some(s) = run.series.iter().find(|s| s.id == id) else {
             continue;
         };
-        let points: Points = s["values"]
-            .as_array()
-            .map(|v| {
-                t.iter()
-                    .copied()
-                    .zip(v.iter().filter_map(Value::as_f64))
-                    .collect()
-            })
-            .unwrap_or_default();
+        let points: Points = t.iter().copied().zip(s.values.iter().copied()).collect();
         if points.is_empty() {
             continue;
         }
         // The report's label, as a title: "hammer angle (°)" → "Hammer angle (deg)".
-        let label = s["label"].as_str().unwrap_or(id).replace("(°)", "(deg)");
+        let label = s.label.replace("(°)", "(deg)");
         let mut title = label[..1].to_uppercase();
         title.push_str(&label[1..]);
         out.push(Panel {
@@ -162,30 +139,21 @@ fn panels(run: &Value) -> Vec<Panel> {
         });
     }
     // Contact forces: those that carry load at some time, largest peak first.
-    let mut forces: Vec<(String, Points, f64)> = run["contacts"]
-        .as_object()
-        .map(|m| {
-            m.iter()
-                .map(|(name, c)| {
-                    let f: Vec<(f64, f64)> = c["f"]
-                        .as_array()
-                        .map(|a| {
-                            t.iter()
-                                .copied()
-                                .zip(a.iter().filter_map(Value::as_f64))
-                                .collect()
-                        })
-                        .unwrap_or_default();
-                    let peak = f.iter().map(|p| p.1).fold(0.0, f64::max);
-                    let label = run["contact_labels"][name]
-                        .as_str()
-                        .map_or_else(|| name.replace('_', " "), str::to_string);
-                    (label, f, peak)
-                })
-                .filter(|c| c.2 > 0.0)
-                .collect()
+    let mut forces: Vec<(String, Points, f64)> = run
+        .contacts
+        .iter()
+        .map(|(name, c)| {
+            let f: Points = t.iter().copied().zip(c.f.iter().copied()).collect();
+            let peak = f.iter().map(|p| p.1).fold(0.0, f64::max);
+            let label = run
+                .contact_labels
+                .get(name)
+                .cloned()
+                .unwrap_or_else(|| name.replace('_', " "));
+            (label, f, peak)
         })
-        .unwrap_or_default();
+        .filter(|c| c.2 > 0.0)
+        .collect();
     forces.sort_by(|a, b| b.2.total_cmp(&a.2));
     if !forces.is_empty() {
         out.push(Panel {
@@ -212,8 +180,8 @@ struct Mark {
 /// The moments marked on the figure: every strike (numbered, from the summary), and the
 /// listed let-offs, key bottoms, checks, drops, jack resets and turning points (see
 /// [`crate::report::listed_events`]), in time order.
-fn marks(run: &Value) -> Vec<Mark> {
-    let mut out: Vec<Mark> = run["summary"]["strikes"]
+fn marks(run: &RunData) -> Vec<Mark> {
+    let mut out: Vec<Mark> = run.summary["strikes"]
         .as_array()
         .map(|a| {
             a.iter()
@@ -227,8 +195,8 @@ fn marks(run: &Value) -> Vec<Mark> {
                 .collect()
         })
         .unwrap_or_default();
-    let described = run["summary"]["metrics"].is_array();
-    for e in run["listed_events"].as_array().into_iter().flatten() {
+    let described = run.summary["metrics"].is_array();
+    for e in run.listed_events.as_array().into_iter().flatten() {
         if described {
             // A description's named events, each under its own name.
             if let (Some(name), Some(t)) = (e["name"].as_str(), e["time_s"].as_f64()) {
@@ -295,11 +263,11 @@ fn place_marks(marks: &[Mark], widths: &[f64], x: (f64, f64), t: (f64, f64)) -> 
 /// Draws the figure on `root`.
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    run: &Value,
+    run: &RunData,
 ) -> std::result::Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(err)?;
-    let title = run["title"].as_str().unwrap_or("run");
+    let title = run.title.as_str();
     let root = root.titled(title, ("sans-serif", 26)).map_err(err)?;
     let t = times_ms(run);
     let (t0, t1) = (

@@ -1,16 +1,22 @@
 //! The interactive report: one self-contained HTML file (no network, works from `file://`)
-//! that replays one or more run directories in slow motion, with the action drawn to scale,
-//! the contact forces as arrows, the events on a timeline and linked plots.
+//! that replays one or more run directories in slow motion, with the mechanism drawn to
+//! scale, the contact forces as arrows, the events on a timeline and linked plots.
 //!
-//! The data are read from the run directory: `run.json` (scenario and parameters, from
-//! which the action is rebuilt for its geometry and kinematics), `trajectory.csv` (the
-//! coordinates and velocities on the output grid), `events.json` and `summary.json`.
-//! Everything the page shows is computed here and embedded as JSON; the page only draws.
+//! The data are read from the run directory's files alone (`run.json`, `poses.csv`,
+//! `contacts.csv`, `series.csv`, `scene.json`, `events.json`, `summary.json`; a grand run
+//! written before the replay files is rebuilt from its parameters), gathered in the typed
+//! [`data::RunData`] and embedded as JSON. The page's script (`report/player.js`,
+//! `view2d.js`, `view3d.js`, `plots.js`, `clock.js`, joined at build time) only draws: every
+//! name, colour, plot and headline comes from the data, so it knows no mechanism.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
+
+pub mod data;
+
+use data::{Carry, ContactSeries, Measured, Plot, ReportData, RunData, Series};
 
 use crate::action::ModelKind;
 use crate::error::{InputKind, PianoError, Result};
@@ -23,7 +29,22 @@ use crate::simulate::{Prepared, key_depth_mm, prepare};
 const STYLE: &str = include_str!("report/report.css");
 /// The `generator` of every report page: a file that lacks it is not overwritten.
 pub const GENERATOR: &str = "piano report";
-const SCRIPT: &str = include_str!("report/report.js");
+/// The page's script: the player, the 2D and 3D views, the plots and the clock, joined in
+/// one function at build time (each file says what it holds; `player.js` has the data's
+/// JSDoc typedef).
+const SCRIPT: &str = concat!(
+    "(function () {\n'use strict';\n\n",
+    include_str!("report/player.js"),
+    "\n",
+    include_str!("report/view2d.js"),
+    "\n",
+    include_str!("report/view3d.js"),
+    "\n",
+    include_str!("report/plots.js"),
+    "\n",
+    include_str!("report/clock.js"),
+    "})();\n"
+);
 
 /// A broken run directory: the error names it.
 fn bad(dir: &Path, message: String) -> PianoError {
@@ -174,16 +195,145 @@ pub(crate) fn run_name(dir: &Path) -> String {
         .unwrap_or_else(|| dir.display().to_string())
 }
 
-/// Plotted series as the page reads them: `[{id, label, values}]`.
-pub(crate) fn series_to_json(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Value> {
+/// Plotted series as the page reads them.
+pub(crate) fn to_series(series: Vec<(&str, &str, Vec<f64>)>) -> Vec<Series> {
     series
         .into_iter()
-        .map(|(id, label, v)| json!({"id": id, "label": label, "values": v}))
+        .map(|(id, label, v)| Series::new(id, label, v))
         .collect()
 }
 
+/// The colours of the grand action's contacts on the page.
+const GRAND_CONTACT_COLORS: [(&str, &str); 11] = [
+    ("hammer_string", "#c0392b"),
+    ("capstan_heel", "#2e8b57"),
+    ("jack_knuckle", "#8e44ad"),
+    ("lever_knuckle", "#2980b9"),
+    ("front_rail", "#d35400"),
+    ("back_rail", "#7f8c8d"),
+    ("let_off_button", "#16a085"),
+    ("drop_screw", "#34495e"),
+    ("backcheck", "#b7950b"),
+    ("rest_rail", "#95a5a6"),
+    ("presser_key", "#555555"),
+];
+
+/// What the grand's event list leaves out, for the page's note (see [`listed_events`]).
+const GRAND_MINOR_EVENTS: &str = "releases, chatter, the jack toe on its button again \
+     before the jack is reset, a second catch without a new blow";
+
+/// The grand's contact colours for `names` (grey for one not in the table).
+fn grand_contact_colors<'a>(
+    names: impl Iterator<Item = &'a str>,
+) -> std::collections::BTreeMap<String, String> {
+    names
+        .map(|n| {
+            let c = GRAND_CONTACT_COLORS
+                .iter()
+                .find(|(k, _)| *k == n)
+                .map_or("#333333", |(_, c)| c);
+            (n.to_string(), c.to_string())
+        })
+        .collect()
+}
+
+/// The grand runs' plots: the hammer, the key, the contact forces, the energies and the
+/// hand's force under a key motion.
+fn grand_plots() -> Vec<Plot> {
+    vec![
+        Plot::of("hammer-angle", "Hammer angle (°)", "hammer_angle_deg"),
+        Plot::of(
+            "hammer-speed",
+            "Hammer speed at the strike point (m/s)",
+            "hammer_speed_m_s",
+        ),
+        Plot::of(
+            "key-depth",
+            "Key-front depth below rest (mm)",
+            "key_depth_mm",
+        ),
+        Plot::contact_forces(),
+        Plot::energy("from rest"),
+        Plot::of(
+            "hand-force",
+            "Hand force at the key front (N)",
+            "key_drive_force_n",
+        ),
+    ]
+}
+
+/// A grand run's headline: the first strike's speed and time.
+fn grand_headline(summary: &Value) -> String {
+    match summary["strikes"].get(0) {
+        Some(first) => format!(
+            "{:.2} m/s at {:.2} ms",
+            first["hammer_velocity_m_s"].as_f64().unwrap_or(f64::NAN),
+            first["time_s"].as_f64().unwrap_or(f64::NAN) * 1e3
+        ),
+        None => "no strike".into(),
+    }
+}
+
+/// The grand's drawing with each part's thickness across the plane (a scene written
+/// before the thickness was part of it gets it here).
+fn with_grand_thickness(mut scene: Value) -> Value {
+    if let Some(parts) = scene["parts"].as_array_mut() {
+        for part in parts {
+            if part.get("thickness").is_none() {
+                let id = part["id"].as_str().unwrap_or_default();
+                let h = crate::drawing::grand_thickness_mm(id);
+                part["thickness"] = json!(h);
+            }
+        }
+    }
+    scene
+}
+
+/// A grand run's data from its parts.
+#[allow(clippy::too_many_arguments)]
+fn grand_run(
+    dir: &Path,
+    scenario: &Scenario,
+    kind: ModelKind,
+    scene: Value,
+    t: Vec<f64>,
+    carry: std::collections::BTreeMap<String, Carry>,
+    contacts: std::collections::BTreeMap<String, ContactSeries>,
+    series: Vec<Series>,
+    zoom: Value,
+) -> Result<RunData> {
+    let contact_labels = contacts
+        .keys()
+        .map(|c| (c.clone(), contact_label(c, &scenario.input)))
+        .collect();
+    let contact_colors = grand_contact_colors(contacts.keys().map(String::as_str));
+    let measured = read_measured(dir, &series)?;
+    let events = read_json(dir, "events.json")?;
+    let summary = read_json(dir, "summary.json")?;
+    Ok(RunData {
+        name: run_name(dir),
+        title: format!("{} action, {}", kind.name(), describe(&scenario.input)),
+        model: kind.name().into(),
+        headline: grand_headline(&summary),
+        scene: with_grand_thickness(scene),
+        t,
+        carry,
+        contacts,
+        contact_labels,
+        contact_colors,
+        series,
+        plots: grand_plots(),
+        listed_events: Value::from(listed_events(events.as_array().map_or(&[], Vec::as_slice))),
+        events,
+        minor_events: GRAND_MINOR_EVENTS.into(),
+        summary,
+        zoom,
+        measured,
+    })
+}
+
 /// The report data of one run directory (see the module docs).
-pub fn run_data(dir: &Path) -> Result<Value> {
+pub fn run_data(dir: &Path) -> Result<RunData> {
     let run = read_json(dir, "run.json")?;
     if run["scenario"].get("mechanism").is_some() {
         return crate::mechanism_run::report_data(dir, &run);
@@ -352,69 +502,28 @@ pub fn run_data(dir: &Path) -> Result<Value> {
         }
     }
 
-    // Where millimetres matter: the contacts that set the regulation, at rest.
-    let mut zoom = serde_json::Map::new();
-    for (label, contact, half) in [
-        ("let-off", "let_off_button", 18.0),
-        ("jack and knuckle", "jack_knuckle", 18.0),
-        ("string", "hammer_string", 25.0),
-        ("backcheck", "backcheck", 25.0),
-        ("capstan", "capstan_heel", 18.0),
-    ] {
-        if action.contacts.contains_key(contact) {
-            // The first side's surface point (the string, the button, the jack top, the
-            // backcheck face, the capstan), not the middle of a wide gap.
-            let o = action.contact_output(contact, 0.0, &x0)?;
-            let p = [
-                o.point[0] - 0.5 * o.gap * o.normal[0],
-                o.point[1] - 0.5 * o.gap * o.normal[1],
-            ];
-            zoom.insert(
-                label.into(),
-                json!({"center": [r(p[0] * 1e3, 2), r(p[1] * 1e3, 2)], "half_width": half}),
-            );
-        }
-    }
-
-    let carry_json: serde_json::Map<String, Value> = frame_names
+    let zoom = zoom_presets(&action, &x0)?;
+    let carry = frame_names
         .iter()
         .zip(carry)
-        .map(|(f, [a, x, y])| (f.to_string(), json!({"a": a, "x": x, "y": y})))
+        .map(|(f, [a, x, y])| (f.to_string(), Carry { a, x, y }))
         .collect();
-    let forces_json: serde_json::Map<String, Value> = contact_names
+    let contacts = contact_names
         .iter()
         .zip(forces)
-        .map(|(c, [f, px, py, nx, ny])| {
-            (
-                c.to_string(),
-                json!({"f": f, "px": px, "py": py, "nx": nx, "ny": ny}),
-            )
-        })
+        .map(|(c, [f, px, py, nx, ny])| (c.to_string(), ContactSeries { f, px, py, nx, ny }))
         .collect();
-    let contact_labels: serde_json::Map<String, Value> = contact_names
-        .iter()
-        .map(|c| (c.to_string(), json!(contact_label(c, &scenario.input))))
-        .collect();
-    let measured = read_measured(dir, &series)?;
-    let series_json = series_to_json(series);
-    let events = read_json(dir, "events.json")?;
-    let name = run_name(dir);
-    Ok(json!({
-        "name": name,
-        "title": format!("{} action, {}", kind.name(), describe(&scenario.input)),
-        "model": kind.name(),
-        "scene": frames,
-        "t": t,
-        "carry": carry_json,
-        "contacts": forces_json,
-        "contact_labels": contact_labels,
-        "series": series_json,
-        "events": events,
-        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
-        "summary": read_json(dir, "summary.json")?,
-        "zoom": zoom,
-        "measured": measured,
-    }))
+    grand_run(
+        dir,
+        &scenario,
+        kind,
+        frames,
+        t,
+        carry,
+        contacts,
+        to_series(series),
+        zoom,
+    )
 }
 
 /// The run-directory file with the drawing's scene and the zoom presets (written by
@@ -534,7 +643,7 @@ fn zoom_presets(action: &crate::Action, x0: &[f64]) -> Result<Value> {
 }
 
 /// The report data of a grand run from its files alone (see [`write_replay_files`]).
-fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Result<Value> {
+fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Result<RunData> {
     let scene_file = read_json(dir, SCENE_JSON)?;
     let frames = scene_file["scene"].clone();
     let frame_names: Vec<String> = frames["frames"]
@@ -567,7 +676,7 @@ fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Re
             .position(|h| h == name)
             .ok_or_else(|| bad(dir, format!("{file} has no column {name}")))
     };
-    let mut carry = serde_json::Map::new();
+    let mut carry = std::collections::BTreeMap::new();
     for f in &frame_names {
         let col = column(&header, &format!("{f}_angle_rad"), "poses.csv")?;
         let take = |k: usize, digits: i32| -> Vec<f64> {
@@ -575,7 +684,11 @@ fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Re
         };
         carry.insert(
             f.clone(),
-            json!({"a": take(0, 6), "x": take(1, 3), "y": take(2, 3)}),
+            Carry {
+                a: take(0, 6),
+                x: take(1, 3),
+                y: take(2, 3),
+            },
         );
     }
     let (header, crow) = read_numeric_csv(dir, "contacts.csv")?;
@@ -594,7 +707,7 @@ fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Re
         .filter_map(|h| h.strip_suffix("_active"))
         .map(str::to_string)
         .collect();
-    let mut forces = serde_json::Map::new();
+    let mut forces = std::collections::BTreeMap::new();
     for name in &contact_names {
         let col = column(&header, &format!("{name}_force_n"), "contacts.csv")?;
         let active = column(&header, &format!("{name}_active"), "contacts.csv")?;
@@ -616,15 +729,8 @@ fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Re
             }
         }
         let [f, px, py, nx, ny] = slot;
-        forces.insert(
-            name.clone(),
-            json!({"f": f, "px": px, "py": py, "nx": nx, "ny": ny}),
-        );
+        forces.insert(name.clone(), ContactSeries { f, px, py, nx, ny });
     }
-    let contact_labels: serde_json::Map<String, Value> = contact_names
-        .iter()
-        .map(|c| (c.clone(), json!(contact_label(c, &scenario.input))))
-        .collect();
     let (header, srow) = read_numeric_csv(dir, "series.csv")?;
     let mut series: Vec<(&str, &str, Vec<f64>)> = Vec::new();
     for (id, label) in GRAND_SERIES {
@@ -637,30 +743,23 @@ fn grand_data_from_files(dir: &Path, scenario: &Scenario, kind: ModelKind) -> Re
             ));
         }
     }
-    let measured = read_measured(dir, &series)?;
-    let events = read_json(dir, "events.json")?;
-    Ok(json!({
-        "name": run_name(dir),
-        "title": format!("{} action, {}", kind.name(), describe(&scenario.input)),
-        "model": kind.name(),
-        "scene": frames,
-        "t": t,
-        "carry": carry,
-        "contacts": forces,
-        "contact_labels": contact_labels,
-        "series": series_to_json(series),
-        "events": events,
-        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
-        "summary": read_json(dir, "summary.json")?,
-        "zoom": scene_file["zoom"].clone(),
-        "measured": measured,
-    }))
+    grand_run(
+        dir,
+        scenario,
+        kind,
+        frames,
+        t,
+        carry,
+        forces,
+        to_series(series),
+        scene_file["zoom"].clone(),
+    )
 }
 
 /// The report data of a pendulum run directory: the hammer hanging on its flange and
 /// swinging by the angle in `trajectory.csv`, the angle, the strike point's speed and the
 /// energies against time, the turning points as events. No key, no contacts.
-fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> Result<Value> {
+fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> Result<RunData> {
     let (header, rows) = read_trajectory(dir)?;
     if header != ["time_s", "hammer_q", "hammer_v"] {
         return Err(bad(
@@ -714,54 +813,85 @@ fn pendulum_data(dir: &Path, params: &ActionParams, release_angle_deg: f64) -> R
             s.2.push(r(v, 4));
         }
     }
+    let series = to_series(series);
     let events = read_json(dir, "events.json")?;
     let measured = read_measured(dir, &series)?;
-    let series_json = series_to_json(series);
+    let summary = read_json(dir, "summary.json")?;
     let [a, x, y] = carry;
-    let name = run_name(dir);
-    Ok(json!({
-        "name": name,
-        "title": format!("hammer swing, released {release_angle_deg}° from hanging"),
-        "model": "pendulum",
-        "scene": crate::drawing::pendulum_scene(params, hanging),
-        "t": t,
-        "carry": {"hammer": {"a": a, "x": x, "y": y}},
-        "contacts": {},
-        "contact_labels": {},
-        "series": series_json,
-        "listed_events": listed_events(events.as_array().map_or(&[], Vec::as_slice)),
-        "events": events,
-        "summary": read_json(dir, "summary.json")?,
-        "zoom": {},
-        "measured": measured,
-    }))
+    let p = &summary["pendulum"];
+    let headline = format!(
+        "{} turning points, period {} (small swings: {:.3} s)",
+        p["turns"].as_array().map_or(0, Vec::len),
+        p["period_s"]
+            .as_f64()
+            .map_or("–".into(), |t| format!("{t:.3} s")),
+        p["small_amplitude_period_s"].as_f64().unwrap_or(f64::NAN)
+    );
+    Ok(RunData {
+        name: run_name(dir),
+        title: format!("hammer swing, released {release_angle_deg}° from hanging"),
+        model: "pendulum".into(),
+        headline,
+        scene: with_grand_thickness(crate::drawing::pendulum_scene(params, hanging)),
+        t,
+        carry: [("hammer".to_string(), Carry { a, x, y })].into(),
+        contacts: Default::default(),
+        contact_labels: Default::default(),
+        contact_colors: Default::default(),
+        series,
+        plots: vec![
+            Plot::of(
+                "hammer-angle",
+                "Hammer angle from hanging (°)",
+                "hammer_angle_deg",
+            ),
+            Plot::of(
+                "hammer-speed",
+                "Hammer speed at the strike point (m/s)",
+                "hammer_speed_m_s",
+            ),
+            Plot::energy("from the release"),
+        ],
+        listed_events: Value::from(listed_events(events.as_array().map_or(&[], Vec::as_slice))),
+        events,
+        minor_events: "releases and chatter".into(),
+        summary,
+        zoom: json!({}),
+        measured,
+    })
 }
 
 /// The measured data of a run, if its directory has `measured.csv` (see
-/// [`crate::measured`]), as `{id: {t: [...], v: [...]}}`.
-fn read_measured(dir: &Path, series: &[(&str, &str, Vec<f64>)]) -> Result<Value> {
+/// [`crate::measured`]), by series id.
+pub(crate) fn read_measured(
+    dir: &Path,
+    series: &[Series],
+) -> Result<Option<std::collections::BTreeMap<String, Measured>>> {
     let path = dir.join("measured.csv");
     if !path.exists() {
-        return Ok(Value::Null);
+        return Ok(None);
     }
     let text = std::fs::read_to_string(&path).map_err(|e| PianoError::io(&path, "read", e))?;
-    let known: Vec<&str> = series.iter().map(|s| s.0).collect();
+    let known: Vec<&str> = series.iter().map(|s| s.id.as_str()).collect();
     let measured = crate::measured::parse_measured(&text, &path, &known)?;
-    Ok(measured
-        .into_iter()
-        .map(|s| {
-            let t: Vec<f64> = s.t.iter().map(|&t| r(t, 6)).collect();
-            let v: Vec<f64> = s.v.iter().map(|&v| r(v, 4)).collect();
-            (s.id, json!({"t": t, "v": v}))
-        })
-        .collect::<serde_json::Map<String, Value>>()
-        .into())
+    Ok(Some(
+        measured
+            .into_iter()
+            .map(|s| {
+                let t: Vec<f64> = s.t.iter().map(|&t| r(t, 6)).collect();
+                let v: Vec<f64> = s.v.iter().map(|&v| r(v, 4)).collect();
+                (s.id, Measured { t, v })
+            })
+            .collect(),
+    ))
 }
 
 /// Embeds `value` as JSON inside a `<script>` element: `</` is escaped so no string in the
 /// data can close the element.
-fn embed(value: &Value) -> String {
-    value.to_string().replace("</", "<\\/")
+fn embed(value: &impl serde::Serialize) -> Result<String> {
+    let text = serde_json::to_string(value)
+        .map_err(|e| PianoError::Simulation(format!("cannot encode the report's data: {e}")))?;
+    Ok(text.replace("</", "<\\/"))
 }
 
 fn escape_html(s: &str) -> String {
@@ -779,8 +909,8 @@ pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
             "give at least one run directory",
         ));
     }
-    let runs: Vec<Value> = dirs.iter().map(|d| run_data(d)).collect::<Result<_>>()?;
-    let swings = runs.iter().filter(|r| r["model"] == "pendulum").count();
+    let runs: Vec<RunData> = dirs.iter().map(|d| run_data(d)).collect::<Result<_>>()?;
+    let swings = runs.iter().filter(|r| r.model == "pendulum").count();
     if swings > 0 && swings < runs.len() {
         return Err(PianoError::option(
             "RUN_DIR",
@@ -790,13 +920,13 @@ pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
     }
     let title = runs
         .iter()
-        .filter_map(|r| r["title"].as_str())
+        .map(|r| r.title.as_str())
         .collect::<Vec<_>>()
         .join(" · ");
-    let data = json!({
-        "version": env!("CARGO_PKG_VERSION"),
-        "runs": runs,
-    });
+    let data = ReportData {
+        version: env!("CARGO_PKG_VERSION").into(),
+        runs,
+    };
     let mut html = String::new();
     let _ = write!(
         html,
@@ -820,7 +950,7 @@ pub fn report_html(dirs: &[PathBuf]) -> Result<String> {
 </html>
 "#,
         escape_html(&format!("Piano action report: {title}")),
-        embed(&data)
+        embed(&data)?
     );
     Ok(html)
 }
@@ -857,7 +987,7 @@ mod tests {
     #[test]
     fn embedded_json_cannot_close_its_script_element() {
         let v = json!({"name": "</script><script>alert(1)</script>"});
-        let text = embed(&v);
+        let text = embed(&v).unwrap();
         assert!(!text.contains("</"), "{text}");
         let back: Value = serde_json::from_str(&text).unwrap();
         assert_eq!(back, v);

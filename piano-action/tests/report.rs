@@ -347,3 +347,49 @@ fn a_run_replays_from_its_files_exactly_as_rebuilt() {
         assert_eq!(from_files, rebuilt, "{name}");
     }
 }
+
+/// The page's script knows no mechanism: every name, colour, plot and headline comes from
+/// the data (`report::data`), so an upright, a glockenspiel or a bell striker is drawn by the
+/// same code as the grand.
+#[test]
+fn the_report_script_names_no_part_of_a_piano() {
+    let files = [
+        ("player.js", include_str!("../src/report/player.js")),
+        ("view2d.js", include_str!("../src/report/view2d.js")),
+        ("view3d.js", include_str!("../src/report/view3d.js")),
+        ("plots.js", include_str!("../src/report/plots.js")),
+        ("clock.js", include_str!("../src/report/clock.js")),
+    ];
+    for (name, text) in files {
+        let lower = text.to_lowercase();
+        for word in [
+            "hammer",
+            "jack",
+            "wippen",
+            "knuckle",
+            "capstan",
+            "backcheck",
+            "presser",
+            "repetition",
+            "let_off",
+            "drop_screw",
+        ] {
+            assert!(!lower.contains(word), "{name} names '{word}'");
+        }
+    }
+    // The typedef documents every field the Rust side writes.
+    let player = files[0].1;
+    for field in [
+        "headline",
+        "contact_colors",
+        "plots",
+        "minor_events",
+        "listed_events",
+        "measured",
+    ] {
+        assert!(
+            player.contains(&format!("}} {field} ")),
+            "the JSDoc typedef lacks {field}"
+        );
+    }
+}

@@ -811,6 +811,15 @@ pub(super) const GRAND_THICKNESS_MM: [(&str, f64); 10] = [
     ("action-bracket", 10.0),
 ];
 
+/// The thickness (mm) of the grand's drawn part `id` across the plane, 10 mm for one not in
+/// [`GRAND_THICKNESS_MM`].
+pub(crate) fn grand_thickness_mm(id: &str) -> f64 {
+    GRAND_THICKNESS_MM
+        .iter()
+        .find(|(k, _)| *k == id)
+        .map_or(10.0, |(_, h)| *h)
+}
+
 /// The grand action's drawing as description outlines: the ground's (world, m) and each
 /// body's (its frame, m), with their colours and thicknesses, so that a description
 /// written by `piano describe` draws like the built-in model.

@@ -34,6 +34,7 @@ mod outlines;
 mod scene;
 mod svg;
 
+pub(crate) use grand::grand_thickness_mm;
 use grand::*;
 pub use grand::{grand_outlines, pendulum_carry, pendulum_scene, pendulum_svg};
 pub use outlines::{mechanism_carry, mechanism_scene, mechanism_svg};

@@ -55,9 +55,9 @@ try {
       await T(() => window.pianoReport.pause());
       return T(() => window.pianoReport.time());
     };
-    const a0 = await T(() => window.pianoReport.hammerAngle());
+    const a0 = await T(() => window.pianoReport.seriesValue('hammer_angle_deg'));
     const fast = await playFor(0.1, 600);
-    const a1 = await T(() => window.pianoReport.hammerAngle());
+    const a1 = await T(() => window.pianoReport.seriesValue('hammer_angle_deg'));
     const slow = await playFor(0.01, 600);
     check(fast > 0 && slow > 0, 'Play advances time (' + (fast * 1e3).toFixed(2) + ' ms at 1/10, ' + (slow * 1e3).toFixed(2) + ' ms at 1/100, in 600 ms)');
     check(slow < fast, 'a slower speed advances it less');
@@ -77,7 +77,7 @@ try {
   // ... to the right frame: frame 40 shows frame 40's hammer.
   const t40 = await R(() => window.pianoReport.frameTime(40));
   await page.$eval('#scrubber', (e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }, String(t40));
-  const [f40, a40, want40] = await R(() => [window.pianoReport.frame(), window.pianoReport.hammerAngle(), window.pianoReport.angleAtFrame(40)]);
+  const [f40, a40, want40] = await R(() => [window.pianoReport.frame(), window.pianoReport.seriesValue('hammer_angle_deg'), window.pianoReport.seriesAtFrame('hammer_angle_deg', 40)]);
   check(f40 === 40 && Math.abs(a40 - want40) < 1e-9, 'the scrubber shows frame 40 and its hammer angle (' + f40 + ', ' + a40 + '°)');
 
   // #t= seeks, also on hashchange.
