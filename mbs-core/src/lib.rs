@@ -49,6 +49,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod aba;
+pub mod alloc_count;
 pub mod benchmarks;
 mod builder;
 pub mod check;

@@ -18,6 +18,14 @@ impl Lu {
         }
     }
 
+    /// The same factorisation for an `n × n` matrix, in the buffers it has (no allocation
+    /// up to the size it was made for).
+    pub fn resize(&mut self, n: usize) {
+        self.n = n;
+        self.a.resize(n * n, 0.0);
+        self.piv.resize(n, 0);
+    }
+
     /// Factors `I − c J` (J column-major, n × n). Returns false when singular.
     pub fn factor_shifted(&mut self, c: f64, jac: &[f64]) -> bool {
         let n = self.n;
@@ -127,9 +135,10 @@ impl IterationMatrix {
         Self {
             n,
             active: (0..n).collect(),
-            passive: Vec::new(),
+            // Room for every split of the states, so that none allocates later.
+            passive: Vec::with_capacity(n),
             lu: Lu::new(n),
-            coupling: Vec::new(),
+            coupling: Vec::with_capacity(n * n / 4 + 1),
             block: vec![0.0; n * n],
             work: vec![0.0; n],
             stale: true,
@@ -159,7 +168,7 @@ impl IterationMatrix {
         }
         let na = self.active.len();
         if self.lu.n != na {
-            self.lu = Lu::new(na);
+            self.lu.resize(na);
             self.block.resize(na * na, 0.0);
         }
         for (cb, &j) in self.active.iter().enumerate() {

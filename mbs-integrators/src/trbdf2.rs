@@ -58,6 +58,9 @@ pub(crate) struct TrBdf2 {
     f_end: Vec<f64>,
     psi: Vec<f64>,
     fz: Vec<f64>,
+    /// The iterate and its derivative where Newton last failed (a Jacobian is taken there).
+    z_fail: Vec<f64>,
+    f_fail: Vec<f64>,
     delta: Vec<f64>,
     est: Vec<f64>,
     jac: nalgebra::DMatrix<f64>,
@@ -110,6 +113,8 @@ impl TrBdf2 {
             f_end: v(),
             psi: v(),
             fz: v(),
+            z_fail: v(),
+            f_fail: v(),
             delta: v(),
             est: v(),
             jac: nalgebra::DMatrix::zeros(n, n),
@@ -341,17 +346,27 @@ impl TrBdf2 {
         h: f64,
         st: &mut Stats,
     ) -> Result<bool> {
-        let (ts, z) = if self.failed_in_end_stage {
-            (self.t + h, self.z_end.clone())
+        // The scratch buffers are taken out while `self` takes the Jacobian, then put back.
+        let mut z = std::mem::take(&mut self.z_fail);
+        let mut fz = std::mem::take(&mut self.f_fail);
+        let ts = if self.failed_in_end_stage {
+            z.copy_from_slice(&self.z_end);
+            self.t + h
         } else {
-            (self.t + GAMMA * h, self.z_gamma.clone())
+            z.copy_from_slice(&self.z_gamma);
+            self.t + GAMMA * h
         };
-        let mut fz = vec![0.0; self.n];
-        if z.iter().any(|v| !v.is_finite()) || !eval(sys, ts, &z, &mut fz, st)? {
-            return Ok(false);
-        }
-        self.jacobian_at(sys, ts, &z, &fz, st)?;
-        Ok(true)
+        let result = if z.iter().any(|v| !v.is_finite()) {
+            Ok(false)
+        } else {
+            match eval(sys, ts, &z, &mut fz, st) {
+                Ok(true) => self.jacobian_at(sys, ts, &z, &fz, st).map(|()| true),
+                other => other,
+            }
+        };
+        self.z_fail = z;
+        self.f_fail = fz;
+        result
     }
 
     /// Both stages with step h. Ok(false) when Newton failed.
