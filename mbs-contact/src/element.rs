@@ -140,8 +140,22 @@ impl Contact {
     }
 
     /// The nearest points of the two sides (the pair of shapes with the smallest gap), in
-    /// world coordinates, from the poses in `ctx`.
+    /// world coordinates, from the poses in `ctx`: the system's position stage when it has
+    /// computed them for this state, else found here.
     pub fn proximity(&self, ctx: &ForceContext<'_>) -> Proximity {
+        if let [gap, nx, ny, ax, ay, bx, by] = *ctx.positions {
+            return Proximity {
+                gap,
+                normal: [nx, ny],
+                point_a: [ax, ay],
+                point_b: [bx, by],
+            };
+        }
+        self.find_proximity(ctx)
+    }
+
+    /// [`Contact::proximity`] found from the poses.
+    fn find_proximity(&self, ctx: &ForceContext<'_>) -> Proximity {
         let (pa, pb) = (
             ctx.body_pose(self.sides[0].body),
             ctx.body_pose(self.sides[1].body),
@@ -341,6 +355,24 @@ impl ForceElement for Contact {
         ];
         loads.add_force_at_point(self.sides[1].body, out.point, f);
         loads.add_force_at_point(self.sides[0].body, out.point, [-f[0], -f[1]]);
+    }
+
+    fn position_len(&self) -> usize {
+        7
+    }
+
+    /// The nearest points: gap, normal, point on A, point on B.
+    fn positions(&self, ctx: &ForceContext<'_>, out: &mut [f64]) {
+        let p = self.find_proximity(ctx);
+        out.copy_from_slice(&[
+            p.gap,
+            p.normal[0],
+            p.normal[1],
+            p.point_a[0],
+            p.point_a[1],
+            p.point_b[0],
+            p.point_b[1],
+        ]);
     }
 
     fn switch_count(&self) -> usize {

@@ -69,6 +69,10 @@ pub struct ForceContext<'a> {
     pub v: &'a [f64],
     /// This element's internal states (empty when it has none).
     pub states: &'a [f64],
+    /// This element's position-stage results at this state
+    /// ([`ForceElement::positions`]), or empty when there are none: they were computed once
+    /// for the state's time and coordinates and are shared by every evaluation there.
+    pub positions: &'a [f64],
 }
 
 impl ForceContext<'_> {
@@ -224,6 +228,21 @@ pub trait ForceElement: Send + Sync {
     fn states_outside_jacobian(&self) -> std::ops::Range<usize> {
         0..0
     }
+
+    /// How many numbers this element keeps from the **position stage**: results that depend
+    /// on the poses alone (time and coordinates, not velocities nor internal states), such
+    /// as a contact's nearest points. The system computes them once per time and
+    /// coordinates ([`ForceElement::positions`]) and hands them to every evaluation there in
+    /// [`ForceContext::positions`]: the derivative, the switching functions, a Jacobian's
+    /// velocity and internal-state columns, outputs. None (0) by default.
+    fn position_len(&self) -> usize {
+        0
+    }
+
+    /// Writes the position-stage results for the poses in `ctx` (its `positions` is empty
+    /// here), `out` of length [`ForceElement::position_len`]. Must not allocate, and must
+    /// not read velocities or internal states.
+    fn positions(&self, _ctx: &ForceContext<'_>, _out: &mut [f64]) {}
 
     /// Number of switching functions (for event location by integrators).
     fn switch_count(&self) -> usize {

@@ -48,15 +48,27 @@ pub struct System {
     switch_len: usize,
     drives: Vec<Option<Arc<dyn Drive>>>,
     mask: Vec<bool>,
+    /// Length of the position-stage results over all elements.
+    position_len: usize,
+    /// Changes whenever the system does (an element added, a drive set or released), so a
+    /// workspace's position stage is never reused across systems that differ.
+    revision: u64,
 }
 
-/// A force element with the ranges of its internal states (in x) and switching functions,
-/// fixed when it is added.
+/// A fresh revision number (unique in the process).
+fn next_revision() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// A force element with the ranges of its internal states (in x), switching functions and
+/// position-stage results, fixed when it is added.
 #[derive(Clone)]
 struct Entry {
     element: Arc<dyn ForceElement>,
     states: Range<usize>,
     switches: Range<usize>,
+    positions: Range<usize>,
 }
 
 /// Per-thread scratch space for evaluating a [`System`]: allocated once by
@@ -74,6 +86,12 @@ pub struct Workspace {
     drive_tau: Vec<f64>,
     scratch_tau: Vec<f64>,
     scratch_forces: Vec<Force>,
+    /// The position stage's results ([`ForceElement::positions`]) at `position_key`.
+    positions: Vec<f64>,
+    /// The system revision, time and coordinates the position stage was computed for
+    /// (`None`: not computed).
+    position_key: Option<(u64, f64)>,
+    position_q: Vec<f64>,
 }
 
 impl Workspace {
@@ -129,6 +147,8 @@ impl System {
             entries: Vec::new(),
             drives: vec![None; nv],
             mask: vec![false; nv],
+            position_len: 0,
+            revision: next_revision(),
         }
     }
 
@@ -148,12 +168,16 @@ impl System {
         element.check_model(&self.model)?;
         let states = self.state_len..self.state_len + element.state_count();
         let switches = self.switch_len..self.switch_len + element.switch_count();
+        let positions = self.position_len..self.position_len + element.position_len();
         self.state_len = states.end;
         self.switch_len = switches.end;
+        self.position_len = positions.end;
+        self.revision = next_revision();
         self.entries.push(Entry {
             element,
             states,
             switches,
+            positions,
         });
         Ok(self.entries.len() - 1)
     }
@@ -170,6 +194,7 @@ impl System {
         let k = self.model.coordinate_id(joint)?;
         self.drives[k] = Some(Arc::new(drive));
         self.mask[k] = true;
+        self.revision = next_revision();
         Ok(())
     }
 
@@ -178,6 +203,7 @@ impl System {
         let k = self.model.coordinate_id(joint)?;
         self.drives[k] = None;
         self.mask[k] = false;
+        self.revision = next_revision();
         Ok(())
     }
 
@@ -242,6 +268,9 @@ impl System {
             drive_tau: vec![0.0; nv],
             scratch_tau: vec![0.0; nv],
             scratch_forces: vec![Force::ZERO; nb],
+            positions: vec![0.0; self.position_len],
+            position_key: None,
+            position_q: vec![0.0; nv],
         }
     }
 
@@ -312,7 +341,9 @@ impl System {
         })
     }
 
-    /// What element code sees: kinematics of the workspace, time and its own states.
+    /// What element code sees: kinematics of the workspace, time, its own states and its
+    /// position-stage results.
+    #[allow(clippy::too_many_arguments)]
     fn context<'a>(
         &'a self,
         data: &'a Data,
@@ -320,6 +351,7 @@ impl System {
         v: &'a [f64],
         t: f64,
         states: &'a [f64],
+        positions: &'a [f64],
     ) -> ForceContext<'a> {
         ForceContext {
             model: &self.model,
@@ -328,6 +360,7 @@ impl System {
             q,
             v,
             states,
+            positions,
         }
     }
 
@@ -352,7 +385,53 @@ impl System {
             }
         }
         kinematics_pass(&self.model, &mut ws.data, &ws.q, Some(&ws.v));
+        self.position_stage(ws, t);
         Ok(())
+    }
+
+    /// The position stage: every element's results that depend on the poses alone, computed
+    /// once per system revision, time and coordinates (a Jacobian's velocity columns, the
+    /// switching functions after a derivative at the same state, outputs reuse them).
+    fn position_stage(&self, ws: &mut Workspace, t: f64) {
+        if self.position_len == 0 {
+            return;
+        }
+        if ws.positions.len() != self.position_len {
+            // A workspace made before an element was added (allocates once).
+            ws.positions.resize(self.position_len, 0.0);
+            ws.position_key = None;
+        }
+        // Bit for bit: the same coordinates give the same poses, hence the same results.
+        let same = ws.position_key.is_some_and(|(rev, t0)| {
+            rev == self.revision
+                && t0.to_bits() == t.to_bits()
+                && ws
+                    .position_q
+                    .iter()
+                    .zip(&ws.q)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+        });
+        if same {
+            return;
+        }
+        for en in &self.entries {
+            if en.positions.is_empty() {
+                continue;
+            }
+            let ctx = ForceContext {
+                model: &self.model,
+                data: &ws.data,
+                t,
+                q: &ws.q,
+                v: &ws.v,
+                states: &[],
+                positions: &[],
+            };
+            en.element
+                .positions(&ctx, &mut ws.positions[en.positions.clone()]);
+        }
+        ws.position_key = Some((self.revision, t));
+        ws.position_q.copy_from_slice(&ws.q);
     }
 
     /// The state derivative `ẋ = f(t, x)`, written into `xdot`. Allocates nothing.
@@ -380,7 +459,14 @@ impl System {
         let (head, rates) = xdot.split_at_mut(2 * nv);
         for en in &self.entries {
             let r = en.states.clone();
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[r.clone()]);
+            let ctx = self.context(
+                &ws.data,
+                &ws.q,
+                &ws.v,
+                t,
+                &x[r.clone()],
+                &ws.positions[en.positions.clone()],
+            );
             let mut loads = Loads::new(&mut ws.tau, &mut ws.forces_world);
             en.element.apply(
                 &ctx,
@@ -436,7 +522,14 @@ impl System {
         for en in &self.entries {
             ws.scratch_tau.fill(0.0);
             ws.scratch_forces.fill(Force::ZERO);
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[en.states.clone()]);
+            let ctx = self.context(
+                &ws.data,
+                &ws.q,
+                &ws.v,
+                t,
+                &x[en.states.clone()],
+                &ws.positions[en.positions.clone()],
+            );
             let mut loads = Loads::new(&mut ws.scratch_tau, &mut ws.scratch_forces);
             let mut rates = vec![0.0; en.states.len()];
             en.element.apply(&ctx, &mut loads, &mut rates);
@@ -493,7 +586,14 @@ impl System {
         }
         self.prepare(ws, t, x)?;
         for en in &self.entries {
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[en.states.clone()]);
+            let ctx = self.context(
+                &ws.data,
+                &ws.q,
+                &ws.v,
+                t,
+                &x[en.states.clone()],
+                &ws.positions[en.positions.clone()],
+            );
             let out = &mut out[en.switches.clone()];
             // Unwritten values show up as NaN rather than as the caller's stale numbers.
             out.fill(f64::NAN);
@@ -518,16 +618,23 @@ impl System {
         x: &'a [f64],
         element: usize,
     ) -> Result<ForceContext<'a>> {
-        let states = self
+        let (states, positions) = self
             .entries
             .get(element)
-            .map(|en| en.states.clone())
+            .map(|en| (en.states.clone(), en.positions.clone()))
             .ok_or_else(|| CoreError::UnknownName {
                 what: "element index",
                 name: element.to_string(),
             })?;
         self.prepare(ws, t, x)?;
-        Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[states]))
+        Ok(self.context(
+            &ws.data,
+            &ws.q,
+            &ws.v,
+            t,
+            &x[states],
+            &ws.positions[positions],
+        ))
     }
 
     /// The kinematics at `(t, x)`: poses and velocities of every body, with prescribed
@@ -540,7 +647,7 @@ impl System {
         x: &'a [f64],
     ) -> Result<ForceContext<'a>> {
         self.prepare(ws, t, x)?;
-        Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[..0]))
+        Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[..0], &[]))
     }
 
     /// The energy of state `x` at time `t`: kinetic, gravitational and stored in elements.
@@ -548,7 +655,14 @@ impl System {
         self.prepare(ws, t, x)?;
         let mut elastic = 0.0;
         for en in &self.entries {
-            let ctx = self.context(&ws.data, &ws.q, &ws.v, t, &x[en.states.clone()]);
+            let ctx = self.context(
+                &ws.data,
+                &ws.q,
+                &ws.v,
+                t,
+                &x[en.states.clone()],
+                &ws.positions[en.positions.clone()],
+            );
             let e = en.element.potential_energy(&ctx);
             if !e.is_finite() {
                 return Err(CoreError::NonFiniteOutput {
