@@ -79,6 +79,7 @@ mod build;
 pub mod description;
 mod error;
 mod evaluate;
+mod frame;
 mod io;
 pub mod toml_lines;
 pub mod transform;
@@ -88,6 +89,7 @@ pub use build::{Built, ContactHandle, Extensions, NoExtensions, normal_law, shap
 pub use description::*;
 pub use error::{MechanismError, Result};
 pub use evaluate::{EventOccurrence, MetricValue};
+pub use frame::WorldFrame;
 pub use io::Format;
 pub use transform::{Flex, MassProps, Side, distal_contact_name, flex_spring_name};
 pub use validate::material_names;

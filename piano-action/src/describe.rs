@@ -52,9 +52,9 @@ fn m(v: [f64; 2]) -> [f64; 2] {
     [v[0] * 1e-3, v[1] * 1e-3]
 }
 
-/// `p − origin`, mm → m.
+/// `p − origin`, mm → m: the world point `p` in the unturned frame at `origin`.
 fn rel(p: [f64; 2], origin: [f64; 2]) -> [f64; 2] {
-    m([p[0] - origin[0], p[1] - origin[1]])
+    mbs_mechanism::WorldFrame::at(origin).local(p)
 }
 
 /// A horizontal ground face at height `y` over `x`, facing up or down (mm in, shape in m).

@@ -20,6 +20,8 @@ pub struct TouchWeight {
     pub friction_weight_gf: f64,
 }
 
+/// One gram-force (N): a gram under standard gravity, 9.80665 m/s² [V] (CGPM 1901), as
+/// touchweights are quoted in grams.
 const GF: f64 = 9.80665e-3;
 
 /// The mean key-front force (gf) while the key turns slowly from `q0` to `q1` over 2 s,

@@ -35,7 +35,7 @@ use piano_action::ActionParams;
 use piano_action::mechanism::{
     Body, BodyPoint, ContactFrictionSpec, ContactPair, ContactPhase, ContactSideSpec, CordSpec,
     EventSpec, Input, InputKind, Joint, JointType, LawSpec, Limits, Marker, Mechanism, Metric,
-    OutlinePart, PivotFrictionSpec, Quantity, ShapeSpec, StringPair, TorsionSpring,
+    OutlinePart, PivotFrictionSpec, Quantity, ShapeSpec, StringPair, TorsionSpring, WorldFrame,
 };
 
 type P = [f64; 2];
@@ -45,35 +45,16 @@ fn m(p: P) -> P {
     [p[0] * 1e-3, p[1] * 1e-3]
 }
 
-/// A body frame: its origin in the world (mm) and its angle (rad).
-#[derive(Clone, Copy)]
-struct Frame {
-    origin: P,
-    angle: f64,
-}
-
-impl Frame {
-    /// A world point (mm) in this frame (m).
-    fn local(&self, p: P) -> P {
-        let (s, c) = self.angle.sin_cos();
-        let d = [p[0] - self.origin[0], p[1] - self.origin[1]];
-        m([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
-    }
-}
+/// A body frame at rest: its origin in the world (mm) and its angle (rad).
+type Frame = WorldFrame;
 
 /// The jack's frame: at its pin, unturned.
-const JACK_FRAME: Frame = Frame {
-    origin: J,
-    angle: 0.0,
-};
+const JACK_FRAME: Frame = WorldFrame::at(J);
 
 /// The hammer's frame: x along the shank (e1), y = e1 turned a quarter counter-clockwise
 /// (= −e2: the layout's hammer axes are left-handed).
 fn hammer_frame() -> Frame {
-    Frame {
-        origin: H,
-        angle: E1[1].atan2(E1[0]),
-    }
+    WorldFrame::turned(H, E1[1].atan2(E1[0]))
 }
 
 /// How far (mm) the back-check face is set back along its normal (0.112, 0.994) from the
@@ -98,10 +79,7 @@ const LIP: P = [102.3, SEAT_Y];
 const SEAT_AT_WALL: P = [106.3, SEAT_Y];
 
 /// The world frame.
-const WORLD: Frame = Frame {
-    origin: [0.0, 0.0],
-    angle: 0.0,
-};
+const WORLD: Frame = WorldFrame::WORLD;
 
 /// Balance pivot (origin) \[def\].
 const KEY_PIVOT: P = [0.0, 0.0];
@@ -237,10 +215,7 @@ fn onset(name: &str, contact: &str, on: ContactPhase) -> EventSpec {
 /// The upright action's description (see the crate docs), checked.
 pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
     let key = WORLD;
-    let wippen = Frame {
-        origin: W,
-        angle: 0.0,
-    };
+    let wippen = WorldFrame::at(W);
     let jack = JACK_FRAME;
     let hammer = hammer_frame();
     let hw = |u: f64, v: f64| hammer_world(u, v);
@@ -610,7 +585,7 @@ pub fn upright_mechanism() -> Result<Mechanism, piano_action::PianoError> {
                 the butt notch, hammer with butt spring, bridle tape and back-check, let-off \
                 button, rest rail, the string in a vertical plane."
             .into(),
-        gravity: [0.0, -9.81],
+        gravity: [0.0, -piano_action::params::GRAVITY_M_S2],
         ground: vec![
             outline(
                 &WORLD,
