@@ -374,3 +374,91 @@ fn mechanism_scenarios_refuse_what_they_cannot_run() {
     assert!(err.contains("no force input"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The example descriptions (a hand-written glockenspiel, the upright written by
+/// `examples/upright`) go through the same commands as the grand: `piano simulate` with
+/// their drawings at the named events, `piano report`, `piano plot` and `piano sweep`, the
+/// metric rising with the force.
+#[test]
+fn the_example_descriptions_simulate_draw_report_plot_and_sweep() {
+    let examples =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/mechanisms");
+    let dir = std::env::temp_dir().join(format!("piano-examples-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, force, metric, drawings) in [
+        (
+            "glockenspiel.toml",
+            [2.0, 6.0, 12.0],
+            "head speed at the strike",
+            ["drawing_rest.svg", "drawing_strike.svg"],
+        ),
+        (
+            "upright.toml",
+            [4.0, 10.0, 25.0],
+            "hammer speed at the strike",
+            ["drawing_rest.svg", "drawing_escape.svg"],
+        ),
+    ] {
+        let path = examples.join(file);
+        let name = file.trim_end_matches(".toml");
+        let head = format!("mechanism = {:?}", path.to_str().unwrap());
+        let sc = scenario(
+            &dir,
+            &format!("{name}_scenario.toml"),
+            &head,
+            &format!("kind = \"force\"\nforce_n = {}", force[1]),
+        );
+        let out = dir.join(name);
+        let (ok, text, err) = piano(&[
+            "simulate",
+            sc.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--report",
+        ]);
+        assert!(ok, "{file}: {err}");
+        assert!(text.contains("strike"), "{file}: {text}");
+        for f in drawings.iter().chain(&["report.html", "run.json"]) {
+            assert!(out.join(f).is_file(), "{file}: {f}");
+        }
+        let (ok, _, err) = piano(&["plot", out.to_str().unwrap()]);
+        assert!(ok, "{file}: {err}");
+        assert!(out.join("figure.svg").is_file());
+        let table = dir.join(format!("{name}_sweep.csv"));
+        let (ok, _, err) = piano(&[
+            "sweep",
+            "--mechanism",
+            path.to_str().unwrap(),
+            "--touch",
+            "force",
+            "--from",
+            &force[0].to_string(),
+            "--to",
+            &force[2].to_string(),
+            "--runs",
+            "3",
+            "--duration",
+            "0.1",
+            "--out",
+            table.to_str().unwrap(),
+        ]);
+        assert!(ok, "{file}: {err}");
+        let csv = std::fs::read_to_string(&table).unwrap();
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let col = header
+            .iter()
+            .position(|h| h.starts_with(metric))
+            .unwrap_or_else(|| panic!("{file}: no '{metric}' in {header:?}"));
+        let speeds: Vec<f64> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(speeds.len(), 3, "{file}");
+        assert!(
+            speeds[0] < speeds[1] && speeds[1] < speeds[2],
+            "{file}: {speeds:?}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
