@@ -364,6 +364,24 @@ impl System {
         }
     }
 
+    /// The context of entry `en` at `(t, x)` from the workspace's last `prepare`.
+    fn entry_context<'a>(
+        &'a self,
+        ws: &'a Workspace,
+        t: f64,
+        x: &'a [f64],
+        en: &Entry,
+    ) -> ForceContext<'a> {
+        self.context(
+            &ws.data,
+            &ws.q,
+            &ws.v,
+            t,
+            &x[en.states.clone()],
+            &ws.positions[en.positions.clone()],
+        )
+    }
+
     /// Loads q, v (drives applied) and runs kinematics.
     fn prepare(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<()> {
         if ws.q.len() != self.model.nv() || ws.forces_world.len() != self.model.nbodies() {
@@ -586,14 +604,7 @@ impl System {
         }
         self.prepare(ws, t, x)?;
         for en in &self.entries {
-            let ctx = self.context(
-                &ws.data,
-                &ws.q,
-                &ws.v,
-                t,
-                &x[en.states.clone()],
-                &ws.positions[en.positions.clone()],
-            );
+            let ctx = self.entry_context(ws, t, x, en);
             let out = &mut out[en.switches.clone()];
             // Unwritten values show up as NaN rather than as the caller's stale numbers.
             out.fill(f64::NAN);
@@ -655,14 +666,7 @@ impl System {
         self.prepare(ws, t, x)?;
         let mut elastic = 0.0;
         for en in &self.entries {
-            let ctx = self.context(
-                &ws.data,
-                &ws.q,
-                &ws.v,
-                t,
-                &x[en.states.clone()],
-                &ws.positions[en.positions.clone()],
-            );
+            let ctx = self.entry_context(ws, t, x, en);
             let e = en.element.potential_energy(&ctx);
             if !e.is_finite() {
                 return Err(CoreError::NonFiniteOutput {
