@@ -2,8 +2,9 @@
 //!
 //! `dataset.json`: `schema_version` (1), `experiment`, `description`, `fps`, `exposure_s`,
 //! `markers` (`{"name", "body", "local_m": [x, y], "sigma_m"}`: a point fixed on a body, in
-//! that body's frame) and `runs` (`{"id", "file", "role": "fit" | "heldout", "conditions":
-//! {...}}`). Each run's CSV: `time_s`, then `<marker>_x_m` and `<marker>_y_m` for every
+//! that body's frame), optionally `drive` (the marker whose measured motion drives the
+//! model, e.g. `"key_front"` in a `key_drive` experiment; the others are compared) and
+//! `runs` (`{"id", "file", "role": "fit" | "heldout", "conditions": {...}}`). Each run's CSV: `time_s`, then `<marker>_x_m` and `<marker>_y_m` for every
 //! marker (world frame, m); an empty cell or `NaN` is a lost frame.
 
 use std::collections::BTreeSet;
@@ -105,6 +106,11 @@ pub struct Dataset {
     pub exposure_s: f64,
     /// The tracked markers.
     pub markers: Vec<MarkerSpec>,
+    /// The marker whose measured motion drives the model (the others are compared), for
+    /// an experiment driven by a measured motion (`key_drive`); none for a free motion (a
+    /// pendulum).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drive: Option<String>,
     /// The runs.
     pub runs: Vec<RunSpec>,
 }
@@ -233,6 +239,21 @@ impl Dataset {
                     format!("must be positive, got {}", m.sigma_m),
                 ));
             }
+        }
+        if let Some(drive) = &self.drive
+            && !self.markers.iter().any(|m| &m.name == drive)
+        {
+            return Err(err(
+                "drive",
+                format!(
+                    "'{drive}' is not one of the markers ({})",
+                    self.markers
+                        .iter()
+                        .map(|m| m.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
         }
         if self.runs.is_empty() {
             return Err(err("runs", "lists no run".into()));

@@ -227,3 +227,35 @@ fn a_marker_on_an_unknown_body_and_a_missing_dataset_are_named() {
         "{e}"
     );
 }
+
+/// A dataset driven by a measured motion names its drive marker; one naming no marker is
+/// refused at the `drive` field with its line.
+#[test]
+fn the_drive_marker_must_be_a_marker() {
+    let with = |drive: &str| {
+        GOOD_JSON.replace(
+            "  \"runs\": [",
+            &format!("  \"drive\": \"{drive}\",\n  \"runs\": ["),
+        )
+    };
+    let dir = write("drive-good", &with("shank"), GOOD_CSV);
+    let d = Dataset::load(&dir).expect("reads");
+    assert_eq!(d.drive.as_deref(), Some("shank"));
+    cleanup(&dir);
+    let dir = write("drive-bad", &with("key_front"), GOOD_CSV);
+    let e = Dataset::load(&dir).unwrap_err();
+    assert_eq!(e.field, "drive");
+    assert_eq!(e.line, Some(11), "the line of \"drive\"");
+    assert!(
+        e.message
+            .contains("'key_front' is not one of the markers (head, shank)"),
+        "{e}"
+    );
+    cleanup(&dir);
+    // Without one (a pendulum), nothing is written for it.
+    let dir = write("drive-none", GOOD_JSON, GOOD_CSV);
+    let d = Dataset::load(&dir).unwrap();
+    assert!(d.drive.is_none());
+    assert!(!serde_json::to_string(&d).unwrap().contains("drive"));
+    cleanup(&dir);
+}

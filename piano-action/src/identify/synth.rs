@@ -279,6 +279,7 @@ pub fn synthesize(
         fps: options.fps,
         exposure_s: options.exposure_s,
         markers,
+        drive: None,
         runs: specs,
     };
     let truth = Truth {
