@@ -171,7 +171,8 @@ enum Command {
     /// nuisance mismatches, AR(1) camera noise, exposure, clock offset, outliers and lost
     /// frames. The truth goes to its own file, which `diagnose` never reads.
     Synth {
-        /// The experiment (only `pendulum`).
+        /// The experiment: `pendulum` (the swing test) or `key_drive` (a mass released on
+        /// the key, every marker tracked, the key front named as the drive).
         #[arg(long, default_value = "pendulum")]
         experiment: String,
         /// The hidden effect, `ID[:name=value,...]` (unset parameters take a clearly
@@ -181,13 +182,20 @@ enum Command {
         /// The seed: the same seed gives the same dataset.
         #[arg(long, default_value_t = 0)]
         seed: u64,
-        /// Release angles (° above horizontal, comma-separated); the first run is fitted,
-        /// the others held out.
+        /// Pendulum: release angles (° above horizontal, comma-separated); the first run
+        /// is fitted, the others held out.
         #[arg(long, default_value = "0,-35", allow_hyphen_values = true)]
         releases: String,
-        /// Length of each run (s).
-        #[arg(long, default_value_t = 4.0, allow_negative_numbers = true)]
-        duration: f64,
+        /// Key drive: heights the mass is released from above the key (mm,
+        /// comma-separated), one run each; the first is fitted, the others held out.
+        #[arg(long, default_value = "0,5", allow_hyphen_values = true)]
+        heights: String,
+        /// Key drive: the mass released on the key (kg).
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        mass: f64,
+        /// Length of each run (s; 4 for a pendulum, 0.3 for a key drive).
+        #[arg(long, allow_negative_numbers = true)]
+        duration: Option<f64>,
         /// The dataset's folder.
         #[arg(long)]
         out: std::path::PathBuf,
@@ -1077,31 +1085,72 @@ fn diagnose(
 
 /// `piano synth`.
 #[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 fn synth(
     params: &piano_action::params::ActionParams,
     experiment: &str,
     effect: Option<&str>,
     seed: u64,
-    releases: &str,
-    duration: f64,
+    (releases, heights, mass): (&str, &str, f64),
+    duration: Option<f64>,
     out: &std::path::Path,
     truth: &std::path::Path,
     force: bool,
 ) -> Result<(), String> {
-    use piano_action::identify::{commands, synth};
-    if experiment != "pendulum" {
-        return Err(format!(
-            "option --experiment: '{experiment}': only 'pendulum' can be synthesised"
-        ));
+    use piano_action::identify::{commands, key_drive, synth};
+    let numbers = |flag: &str, text: &str| {
+        text.split(',')
+            .map(|r| {
+                r.trim()
+                    .parse::<f64>()
+                    .map_err(|_| format!("option {flag}: '{r}' is not a number"))
+            })
+            .collect::<Result<Vec<_>, _>>()
+    };
+    match experiment {
+        "pendulum" => {}
+        key_drive::EXPERIMENT => {
+            if effect.is_some() {
+                return Err(
+                    "option --effect: the key_drive experiment has no effect library yet \
+                     (key_flex, shank_flex, backcheck_compliance, keybed_felt, \
+                     felt_hysteresis and knuckle_friction come next); leave --effect out for \
+                     the baseline action"
+                        .into(),
+                );
+            }
+            let options = key_drive::KeyDriveOptions {
+                seed,
+                mass_kg: mass,
+                release_heights_m: numbers("--heights", heights)?
+                    .into_iter()
+                    .map(|h| h * 1e-3)
+                    .collect(),
+                duration_s: duration.unwrap_or(0.3),
+                ..Default::default()
+            };
+            commands::synth_key_drive_to_disk(params, &options, out, truth, force)
+                .map_err(|e| e.to_string())?;
+            println!(
+                "dataset: {} ({} run(s) of {} s at {} fps, {} kg on the key, the key front \
+                 as the drive)\ntruth: {}",
+                out.display(),
+                options.release_heights_m.len(),
+                options.duration_s,
+                options.fps,
+                options.mass_kg,
+                truth.display()
+            );
+            return Ok(());
+        }
+        other => {
+            return Err(format!(
+                "option --experiment: '{other}': 'pendulum' or 'key_drive'"
+            ));
+        }
     }
-    let releases_deg = releases
-        .split(',')
-        .map(|r| {
-            r.trim()
-                .parse::<f64>()
-                .map_err(|_| format!("option --releases: '{r}' is not a number"))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let duration = duration.unwrap_or(4.0);
+    let releases_deg = numbers("--releases", releases)?;
     let options = synth::SynthOptions {
         effect: effect
             .map(synth::parse_effect)
@@ -1199,6 +1248,8 @@ fn main() -> ExitCode {
                 effect,
                 seed,
                 releases,
+                heights,
+                mass,
                 duration,
                 out,
                 truth,
@@ -1208,7 +1259,7 @@ fn main() -> ExitCode {
                 &experiment,
                 effect.as_deref(),
                 seed,
-                &releases,
+                (&releases, &heights, mass),
                 duration,
                 &out,
                 &truth,

@@ -20,6 +20,45 @@ pub fn synth_to_disk(
     truth: &Path,
     force: bool,
 ) -> Result<()> {
+    check_synth_paths(out, truth, force)?;
+    let (dataset, runs, truth_record) = synthesize(params, options)?;
+    write_synth(out, truth, &dataset, &runs, &truth_record)
+}
+
+/// Writes a synthetic key-drive dataset (issue 15) into `out` and its truth to `truth`,
+/// refusing as [`synth_to_disk`] does.
+pub fn synth_key_drive_to_disk(
+    params: &ActionParams,
+    options: &super::key_drive::KeyDriveOptions,
+    out: &Path,
+    truth: &Path,
+    force: bool,
+) -> Result<()> {
+    check_synth_paths(out, truth, force)?;
+    let (dataset, runs, truth_record) = super::key_drive::synthesize(params, options)?;
+    write_synth(out, truth, &dataset, &runs, &truth_record)
+}
+
+/// Writes a dataset and its truth record.
+fn write_synth(
+    out: &Path,
+    truth: &Path,
+    dataset: &mbs_identify::Dataset,
+    runs: &[mbs_identify::RunData],
+    truth_record: &impl serde::Serialize,
+) -> Result<()> {
+    dataset
+        .write(out, runs)
+        .map_err(|e| PianoError::io(out, "write the dataset", e))?;
+    let text = serde_json::to_string_pretty(truth_record)
+        .map_err(|e| PianoError::file(truth, format!("cannot encode: {e}")))?;
+    std::fs::write(truth, text + "\n").map_err(|e| PianoError::io(truth, "write", e))?;
+    Ok(())
+}
+
+/// Where a synthetic dataset and its truth may go: a folder (not a file), a `.json` truth
+/// outside it, neither replaced without `force`.
+fn check_synth_paths(out: &Path, truth: &Path, force: bool) -> Result<()> {
     if out.exists() && !out.is_dir() {
         return Err(PianoError::option(
             "--out",
@@ -78,13 +117,6 @@ pub fn synth_to_disk(
             "exists; choose another --truth, or pass --force to replace it",
         ));
     }
-    let (dataset, runs, truth_record) = synthesize(params, options)?;
-    dataset
-        .write(out, &runs)
-        .map_err(|e| PianoError::io(out, "write the dataset", e))?;
-    let text = serde_json::to_string_pretty(&truth_record)
-        .map_err(|e| PianoError::file(truth, format!("cannot encode: {e}")))?;
-    std::fs::write(truth, text + "\n").map_err(|e| PianoError::io(truth, "write", e))?;
     Ok(())
 }
 

@@ -222,8 +222,14 @@ pub(super) fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
         return Err(PianoError::File {
             path: file,
             message: format!(
-                "field `experiment`: '{}': `piano diagnose` knows the 'pendulum' experiment",
-                dataset.experiment
+                "field `experiment`: '{}': `piano diagnose` knows the 'pendulum' experiment{}",
+                dataset.experiment,
+                if dataset.experiment == super::key_drive::EXPERIMENT {
+                    " (`piano synth` writes key-drive datasets; their diagnosis is not built \
+                     yet)"
+                } else {
+                    ""
+                }
             ),
         });
     }

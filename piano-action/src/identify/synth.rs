@@ -119,6 +119,87 @@ pub fn default_markers(sigma_m: f64) -> Vec<MarkerSpec> {
     ]
 }
 
+/// What a camera tracker adds to the clean marker tracks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TrackingNoise {
+    /// Marginal SD per coordinate (m).
+    pub sigma_m: f64,
+    /// Lag-one correlation.
+    pub rho: f64,
+    /// Fraction of frames with a gross error.
+    pub outlier_fraction: f64,
+    /// Size of a gross error, in σ.
+    pub outlier_sigmas: f64,
+    /// Fraction of frames lost.
+    pub lost_fraction: f64,
+}
+
+impl SynthOptions {
+    fn noise(&self) -> TrackingNoise {
+        TrackingNoise {
+            sigma_m: self.sigma_m,
+            rho: self.rho,
+            outlier_fraction: self.outlier_fraction,
+            outlier_sigmas: self.outlier_sigmas,
+            lost_fraction: self.lost_fraction,
+        }
+    }
+}
+
+/// Per marker, per frame: a tracked position, or `None` for a lost frame.
+pub(crate) type Tracks = Vec<Vec<Option<[f64; 2]>>>;
+
+/// The tracked frames of the clean tracks `clean` (per marker, per frame): AR(1) noise on
+/// each marker's coordinates, then gross errors of `outlier_sigmas` σ on one marker's x, y
+/// or both and lost frames of one marker, each at random frames. Returns the frames, the
+/// frames with a gross error and the frames with a lost marker.
+pub(crate) fn tracked(
+    rng: &mut Rng,
+    clean: Vec<Vec<[f64; 2]>>,
+    noise: &TrackingNoise,
+) -> (Tracks, Vec<usize>, Vec<usize>) {
+    let frames = clean.first().map_or(0, Vec::len);
+    let mut positions = Vec::new();
+    for track in clean {
+        let nx = rng.ar1(frames, noise.sigma_m, noise.rho);
+        let ny = rng.ar1(frames, noise.sigma_m, noise.rho);
+        positions.push(
+            track
+                .iter()
+                .zip(nx.iter().zip(&ny))
+                .map(|(p, (ex, ey))| Some([p[0] + ex, p[1] + ey]))
+                .collect::<Vec<_>>(),
+        );
+    }
+    let markers = positions.len();
+    let mut outliers = Vec::new();
+    let mut lost = Vec::new();
+    for k in 0..frames {
+        if rng.uniform() < noise.outlier_fraction {
+            // A gross error on one marker's x, y or both, ±10 σ.
+            let m = (rng.uniform() * markers as f64) as usize % markers;
+            let which = (rng.uniform() * 3.0) as usize;
+            if let Some(Some(p)) = positions[m].get_mut(k) {
+                for (axis, v) in p.iter_mut().enumerate() {
+                    if which == 2 || which == axis {
+                        let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                        *v += sign * noise.outlier_sigmas * noise.sigma_m;
+                    }
+                }
+            }
+            outliers.push(k);
+        }
+        if rng.uniform() < noise.lost_fraction {
+            let m = (rng.uniform() * markers as f64) as usize % markers;
+            if let Some(slot) = positions[m].get_mut(k) {
+                *slot = None;
+            }
+            lost.push(k);
+        }
+    }
+    (positions, outliers, lost)
+}
+
 /// A run's id from its release angle: `release_0`, `release_m35`.
 pub fn run_id(release_deg: f64) -> String {
     let text = format!("{release_deg}").replace('-', "m").replace('.', "p");
@@ -208,44 +289,11 @@ pub fn synthesize(
             offset_s: offset,
         };
         let path = model.simulate(true_release.to_radians(), options.duration_s + 0.01);
-        let mut positions = Vec::new();
-        for m in &markers {
-            let clean = path.frames(&camera, &times, m.local_m);
-            let nx = rng.ar1(frames, options.sigma_m, options.rho);
-            let ny = rng.ar1(frames, options.sigma_m, options.rho);
-            positions.push(
-                clean
-                    .iter()
-                    .zip(nx.iter().zip(&ny))
-                    .map(|(p, (ex, ey))| Some([p[0] + ex, p[1] + ey]))
-                    .collect::<Vec<_>>(),
-            );
-        }
-        let mut outliers = Vec::new();
-        let mut lost = Vec::new();
-        for k in 0..frames {
-            if rng.uniform() < options.outlier_fraction {
-                // A gross error on one marker's x, y or both, ±10 σ.
-                let m = (rng.uniform() * markers.len() as f64) as usize % markers.len();
-                let which = (rng.uniform() * 3.0) as usize;
-                if let Some(Some(p)) = positions[m].get_mut(k) {
-                    for (axis, v) in p.iter_mut().enumerate() {
-                        if which == 2 || which == axis {
-                            let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-                            *v += sign * options.outlier_sigmas * options.sigma_m;
-                        }
-                    }
-                }
-                outliers.push(k);
-            }
-            if rng.uniform() < options.lost_fraction {
-                let m = (rng.uniform() * markers.len() as f64) as usize % markers.len();
-                if let Some(slot) = positions[m].get_mut(k) {
-                    *slot = None;
-                }
-                lost.push(k);
-            }
-        }
+        let clean: Vec<Vec<[f64; 2]>> = markers
+            .iter()
+            .map(|m| path.frames(&camera, &times, m.local_m))
+            .collect();
+        let (positions, outliers, lost) = tracked(&mut rng, clean, &options.noise());
         specs.push(RunSpec {
             id: id.clone(),
             file: format!("{id}.csv"),

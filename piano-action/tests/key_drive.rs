@@ -1,0 +1,228 @@
+//! Synthetic key-drive datasets (issue 15, the seed's second experiment): a 1 kg mass on
+//! the key, every marker through the camera model, the key front named as the drive.
+
+use mbs_identify::Dataset;
+use piano_action::ActionParams;
+use piano_action::identify::key_drive::{DRIVE_MARKER, EXPERIMENT, KeyDriveOptions, synthesize};
+
+#[test]
+fn a_synthetic_key_drive_dataset_records_the_drop_and_reads_back() {
+    let params = ActionParams::reference();
+    let options = KeyDriveOptions {
+        seed: 3,
+        ..KeyDriveOptions::default()
+    };
+    let (dataset, runs, truth) = synthesize(&params, &options).expect("it synthesises");
+    assert_eq!(dataset.experiment, EXPERIMENT);
+    assert_eq!(dataset.drive.as_deref(), Some(DRIVE_MARKER));
+    assert_eq!(runs.len(), 2);
+    assert_eq!(runs[0].time_s.len(), 900, "0.3 s at 3000 fps");
+    // The nuisance mismatches stay in their ranges (masses 3 %, felts 15 %, frictions 20 %).
+    for (path, f) in &truth.nuisance {
+        let range = if path.ends_with(".mass_g") {
+            0.03
+        } else if path.ends_with(".k") {
+            0.15
+        } else {
+            0.20
+        };
+        assert!((f - 1.0).abs() <= range, "{path}: {f}");
+    }
+    assert!(truth.nuisance.contains_key("hammer.mass_g"));
+    assert!(truth.nuisance.contains_key("contacts.jack_knuckle.k"));
+    assert!(!truth.nuisance.contains_key("contacts.hammer_string.k"));
+
+    // What the markers saw: the key front goes down by about the dip, the hammer head
+    // rises by about the blow and comes back down to the check.
+    let track = |name: &str| {
+        let m = dataset.markers.iter().position(|m| m.name == name).unwrap();
+        runs[0].positions[m]
+            .iter()
+            .filter_map(|p| *p)
+            .collect::<Vec<[f64; 2]>>()
+    };
+    let front = track("key_front");
+    let dip_mm = (front[0][1] - front.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min)) * 1e3;
+    assert!(
+        (8.0..13.0).contains(&dip_mm),
+        "key front dip {dip_mm:.2} mm"
+    );
+    let head = track("hammer_head");
+    let rise_mm = (head.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max) - head[0][1]) * 1e3;
+    assert!(
+        (30.0..60.0).contains(&rise_mm),
+        "hammer head rise {rise_mm:.1} mm"
+    );
+    let end_mm = (head[head.len() - 1][1] - head[0][1]) * 1e3;
+    assert!(
+        end_mm < rise_mm - 5.0,
+        "the head falls back to the check: {end_mm:.1} mm"
+    );
+    // The tracking noise: frame-to-frame jitter of a marker at rest (the key's back end
+    // before the drop) is of the order of σ.
+    let back = track("key_back");
+    let jitter: f64 = back[..20]
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).abs())
+        .sum::<f64>()
+        / 19.0;
+    assert!(
+        jitter > 1e-6 && jitter < 10.0 * options.sigma_m,
+        "{jitter:e}"
+    );
+
+    // Written and read back as a dataset, its markers on the model's bodies.
+    let dir = std::env::temp_dir().join(format!("piano-key-drive-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dataset.write(&dir, &runs).expect("it writes");
+    let back = Dataset::load(&dir).expect("it reads");
+    assert_eq!(back.drive.as_deref(), Some(DRIVE_MARKER));
+    back.check_bodies(&["key", "wippen", "jack", "repetition_lever", "hammer"])
+        .expect("markers on the action's bodies");
+    let run = back
+        .read_run(&back.runs[1])
+        .expect("the held-out run reads");
+    assert_eq!(run.time_s.len(), 900);
+    std::fs::remove_dir_all(&dir).ok();
+
+    // The same seed gives the same dataset; another, other mismatches.
+    let (again, runs_again, _) = synthesize(&params, &options).unwrap();
+    assert_eq!((again, runs_again), (dataset, runs));
+    let (_, _, other) = synthesize(
+        &params,
+        &KeyDriveOptions {
+            seed: 4,
+            ..options.clone()
+        },
+    )
+    .unwrap();
+    assert_ne!(other.nuisance, truth.nuisance);
+}
+
+#[test]
+fn bad_key_drive_options_name_their_flag() {
+    let params = ActionParams::reference();
+    for (options, flag) in [
+        (
+            KeyDriveOptions {
+                release_heights_m: vec![],
+                ..Default::default()
+            },
+            "--heights",
+        ),
+        (
+            KeyDriveOptions {
+                mass_kg: f64::NAN,
+                ..Default::default()
+            },
+            "--mass",
+        ),
+        (
+            KeyDriveOptions {
+                duration_s: 100.0,
+                ..Default::default()
+            },
+            "--duration",
+        ),
+        (
+            KeyDriveOptions {
+                exposure_s: 1.0,
+                ..Default::default()
+            },
+            "--exposure",
+        ),
+    ] {
+        let e = synthesize(&params, &options).unwrap_err();
+        assert_eq!(e.field(), flag, "{e}");
+    }
+}
+
+fn piano(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_piano"))
+        .args(args)
+        .output()
+        .expect("piano runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn piano_synth_writes_a_key_drive_dataset() {
+    let dir = std::env::temp_dir().join(format!("piano-synth-key-drive-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (data, truth) = (dir.join("data"), dir.join("truth.json"));
+    let args = |extra: &[&'static str]| {
+        let mut a = vec![
+            "synth".to_string(),
+            "--experiment".into(),
+            "key_drive".into(),
+            "--out".into(),
+            data.to_str().unwrap().into(),
+            "--truth".into(),
+            truth.to_str().unwrap().into(),
+        ];
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let run = |a: Vec<String>| piano(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let (ok, out, err) = run(args(&["--heights", "0", "--duration", "0.1"]));
+    assert!(ok, "{err}");
+    assert!(out.contains("the key front as the drive"), "{out}");
+    let d = Dataset::load(&data).expect("the dataset reads");
+    assert_eq!((d.experiment.as_str(), d.runs.len()), ("key_drive", 1));
+    assert_eq!(d.runs[0].conditions["mass_kg"], 1.0);
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&truth).unwrap()).unwrap();
+    assert!(t["nuisance"]["hammer.mass_g"].is_number());
+    // Nothing is replaced without --force; effects are not in this experiment's library
+    // yet; an unknown experiment is named.
+    let (ok, _, err) = run(args(&["--duration", "0.1"]));
+    assert!(!ok && err.contains("--force"), "{err}");
+    let (ok, _, err) = run(args(&["--effect", "key_flex", "--force"]));
+    assert!(!ok && err.contains("no effect library yet"), "{err}");
+    let (ok, _, err) = piano(&[
+        "synth",
+        "--experiment",
+        "typebar",
+        "--out",
+        data.to_str().unwrap(),
+        "--truth",
+        truth.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("'typebar'"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `piano diagnose` says plainly that it cannot diagnose a key drive yet.
+#[test]
+fn diagnose_says_a_key_drive_is_not_diagnosed_yet() {
+    let params = ActionParams::reference();
+    let (dataset, runs, _) = synthesize(
+        &params,
+        &KeyDriveOptions {
+            release_heights_m: vec![0.0],
+            duration_s: 0.05,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("piano-kd-diagnose-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dataset.write(&dir, &runs).unwrap();
+    let out = dir.join("diag");
+    let (ok, _, err) = piano(&[
+        "diagnose",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !ok && err.contains("their diagnosis is not built yet"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
