@@ -1085,7 +1085,6 @@ fn diagnose(
 
 /// `piano synth`.
 #[allow(clippy::too_many_arguments)]
-#[allow(clippy::too_many_arguments)]
 fn synth(
     params: &piano_action::params::ActionParams,
     experiment: &str,
