@@ -80,6 +80,9 @@ pub struct KeyDriveOptions {
     pub outlier_sigmas: f64,
     /// Fraction of frames lost.
     pub lost_fraction: f64,
+    /// Whether the action differs from the parameter file by the nuisance mismatches (off:
+    /// the file's action exactly, to check the pipeline).
+    pub nuisance: bool,
 }
 
 impl Default for KeyDriveOptions {
@@ -97,6 +100,7 @@ impl Default for KeyDriveOptions {
             outlier_fraction: 0.003,
             outlier_sigmas: 10.0,
             lost_fraction: 0.001,
+            nuisance: true,
         }
     }
 }
@@ -227,6 +231,17 @@ fn marker_tracks(
     markers: &[MarkerSpec],
 ) -> Result<(Vec<f64>, CleanTracks)> {
     let run = simulate(params, kind, input, duration_s, 2e-5)?;
+    marker_tracks_of(params, kind, input, &run, markers)
+}
+
+/// The world positions (m) of `markers` along `run` (simulated from `input`).
+fn marker_tracks_of(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    run: &crate::simulate::Run,
+    markers: &[MarkerSpec],
+) -> Result<(Vec<f64>, CleanTracks)> {
     let prepared = prepare(params, kind, input)?;
     let system = &prepared.action.system;
     let model = system.model();
@@ -272,7 +287,11 @@ pub fn synthesize(
 ) -> Result<(Dataset, Vec<RunData>, KeyDriveTruth)> {
     check(options)?;
     let mut rng = Rng::new(options.seed);
-    let (truth_params, nuisance) = mismatched(params, &mut rng)?;
+    let (truth_params, nuisance) = if options.nuisance {
+        mismatched(params, &mut rng)?
+    } else {
+        (params.clone(), BTreeMap::new())
+    };
     let markers = default_markers(params, options.sigma_m);
     let frames = (options.duration_s * options.fps).round() as usize;
     let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.fps).collect();
@@ -363,4 +382,238 @@ pub fn synthesize(
         runs: truth_runs,
     };
     Ok((dataset, runs, truth))
+}
+
+/// A quadratic fitted by least squares to `(x, y)` points, evaluated at `x0` (`None` with
+/// fewer than 3 points).
+fn local_quadratic(points: &[(f64, f64)], x0: f64) -> Option<f64> {
+    if points.len() < 3 {
+        return None;
+    }
+    // Normal equations in u = x − x0 (well conditioned over a few frames).
+    let mut a = [[0.0f64; 3]; 3];
+    let mut b = [0.0f64; 3];
+    for &(x, y) in points {
+        let u = x - x0;
+        let basis = [1.0, u, u * u];
+        for i in 0..3 {
+            b[i] += basis[i] * y;
+            for j in 0..3 {
+                a[i][j] += basis[i] * basis[j];
+            }
+        }
+    }
+    // Gaussian elimination with partial pivoting; the value at x0 is the constant term.
+    for k in 0..3 {
+        let p = (k..3).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))?;
+        a.swap(k, p);
+        b.swap(k, p);
+        if a[k][k].abs() < 1e-300 {
+            return None;
+        }
+        for i in k + 1..3 {
+            let f = a[i][k] / a[k][k];
+            let pivot_row = a[k];
+            for (aij, akj) in a[i].iter_mut().zip(pivot_row).skip(k) {
+                *aij -= f * akj;
+            }
+            b[i] -= f * b[k];
+        }
+    }
+    let mut c = [0.0f64; 3];
+    for k in (0..3).rev() {
+        let s: f64 = (k + 1..3).map(|j| a[k][j] * c[j]).sum();
+        c[k] = (b[k] - s) / a[k][k];
+    }
+    Some(c[0])
+}
+
+/// A smoothing of a tracked signal that gross errors do not reach: the frames
+/// [`mbs_identify::noise::detect_outliers`] flags (a leave-one-out local cubic, as for the
+/// swing test) are dropped with the lost ones (`None`), then a local quadratic over ±`half`
+/// frames is fitted at each frame. `None` where too few frames were seen.
+pub fn smooth_robust(times: &[f64], values: &[Option<f64>], half: usize) -> Vec<Option<f64>> {
+    let n = times.len();
+    let flagged = mbs_identify::noise::detect_outliers(
+        times,
+        &[values],
+        &mbs_identify::noise::OutlierOptions::default(),
+    );
+    (0..n)
+        .map(|k| {
+            let pts: Vec<(f64, f64)> = (k.saturating_sub(half)..(k + half + 1).min(n))
+                .filter(|&i| !flagged[i])
+                .filter_map(|i| values[i].map(|v| (times[i], v)))
+                .collect();
+            local_quadratic(&pts, times[k])
+        })
+        .collect()
+}
+
+/// A run replayed: the key driven by the smoothed drive marker, every other marker
+/// simulated and filmed by the camera model, against what was measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Replay {
+    /// Frame times (s).
+    pub time_s: Vec<f64>,
+    /// The key-front depth below rest that drove the model, per frame (mm).
+    pub drive_depth_mm: Vec<f64>,
+    /// Per marker (the dataset's order; the drive's own is its smoothed track): the
+    /// simulated frames (m).
+    pub predicted: Vec<Vec<[f64; 2]>>,
+    /// Per marker: the distance (m) from the measured to the simulated position per frame,
+    /// `None` for a lost frame.
+    pub residual_m: Vec<Vec<Option<f64>>>,
+    /// The model's events in the replay (name, time).
+    pub events: Vec<(String, f64)>,
+}
+
+impl Replay {
+    /// The RMS residual (m) of marker `m` over the frames with `from ≤ t < to`.
+    pub fn rms(&self, m: usize, from: f64, to: f64) -> Option<f64> {
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (t, r) in self.time_s.iter().zip(&self.residual_m[m]) {
+            if let Some(r) = r
+                && (from..to).contains(t)
+            {
+                sum += r * r;
+                count += 1;
+            }
+        }
+        (count > 0).then(|| (sum / count as f64).sqrt())
+    }
+}
+
+/// Replays `run` of the key-drive `dataset` on the action of `params`: the drive marker's
+/// track is smoothed ([`smooth_robust`], ±6 frames), turned into the key's angle about its
+/// balance pivot and depth below the first frame's, and prescribes the key (as a scenario's
+/// `kind = "motion"`); the other markers are simulated and filmed with the dataset's
+/// exposure.
+pub fn replay(
+    params: &ActionParams,
+    kind: ModelKind,
+    dataset: &Dataset,
+    run: &RunData,
+) -> Result<Replay> {
+    let file = dataset.dir.join("dataset.json");
+    let bad = |message: String| PianoError::File {
+        path: file.clone(),
+        message,
+    };
+    let drive_name = dataset
+        .drive
+        .as_deref()
+        .ok_or_else(|| bad("field `drive`: a key-drive dataset names its drive marker".into()))?;
+    let d = dataset
+        .markers
+        .iter()
+        .position(|m| m.name == drive_name)
+        .ok_or_else(|| bad(format!("field `drive`: no marker '{drive_name}'")))?;
+    let marker = &dataset.markers[d];
+    if marker.body != "key" {
+        return Err(bad(format!(
+            "field `drive`: '{drive_name}' is on the {}; the drive is a marker on the key",
+            marker.body
+        )));
+    }
+    // The key's angle from the marker: world p = pivot + R(θ) local.
+    let pivot = [params.key.pivot_mm[0] * 1e-3, params.key.pivot_mm[1] * 1e-3];
+    let local = marker.local_m;
+    let local_angle = local[1].atan2(local[0]);
+    let angles: Vec<Option<f64>> = run.positions[d]
+        .iter()
+        .map(|p| p.map(|p| (p[1] - pivot[1]).atan2(p[0] - pivot[0]) - local_angle))
+        .collect();
+    let smooth = smooth_robust(&run.time_s, &angles, 6);
+    let key = KeyGeometry::of(&params.key);
+    let start = smooth
+        .iter()
+        .flatten()
+        .next()
+        .copied()
+        .ok_or_else(|| bad("the drive marker is never seen".into()))?;
+    let mut points = Vec::new();
+    let mut drive_depth_mm = Vec::new();
+    for (&t, a) in run.time_s.iter().zip(&smooth) {
+        let depth = a.map_or(f64::NAN, |a| key.depth_mm(a) - key.depth_mm(start));
+        drive_depth_mm.push(depth);
+        if depth.is_finite() {
+            // The table starts at t = 0 at rest.
+            points.push((
+                t - run.time_s[0],
+                if points.is_empty() { 0.0 } else { depth },
+            ));
+        }
+    }
+    let duration = run.time_s[run.time_s.len() - 1] - run.time_s[0];
+    let input = Input::Motion { points };
+    let sim = simulate(params, kind, &input, duration, 2e-5)?;
+    let (sim_t, tracks) = marker_tracks_of(params, kind, &input, &sim, &dataset.markers)?;
+    let camera = Camera {
+        exposure_s: dataset.exposure_s,
+        offset_s: 0.0,
+    };
+    let predicted: Vec<Vec<[f64; 2]>> = tracks
+        .iter()
+        .map(|track| {
+            run.time_s
+                .iter()
+                .map(|&t| {
+                    let t = t - run.time_s[0];
+                    camera
+                        .frame(t, |s| Some(at(&sim_t, track, s)))
+                        .unwrap_or(track[0])
+                })
+                .collect()
+        })
+        .collect();
+    let residual_m = predicted
+        .iter()
+        .zip(&run.positions)
+        .map(|(pred, meas)| {
+            pred.iter()
+                .zip(meas)
+                .map(|(p, m)| m.map(|m| (m[0] - p[0]).hypot(m[1] - p[1])))
+                .collect()
+        })
+        .collect();
+    Ok(Replay {
+        time_s: run.time_s.clone(),
+        drive_depth_mm,
+        predicted,
+        residual_m,
+        events: sim
+            .events
+            .iter()
+            .map(|e| (e.name.to_string(), e.time_s))
+            .collect(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth motion with a gross error and lost frames comes back smooth: the error
+    /// does not pull the neighbours, the lost frames are filled.
+    #[test]
+    fn robust_smoothing_ignores_gross_errors_and_fills_lost_frames() {
+        let times: Vec<f64> = (0..200).map(|k| k as f64 / 3000.0).collect();
+        let truth = |t: f64| 0.01 * (40.0 * t).sin();
+        let mut rng = Rng::new(7);
+        let mut values: Vec<Option<f64>> = times
+            .iter()
+            .map(|&t| Some(truth(t) + 1e-5 * (rng.uniform() - 0.5)))
+            .collect();
+        values[100] = Some(truth(times[100]) + 1e-3);
+        values[50] = None;
+        values[51] = None;
+        let s = smooth_robust(&times, &values, 6);
+        let worst = times
+            .iter()
+            .zip(&s)
+            .map(|(&t, v)| (v.expect("every frame") - truth(t)).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-5, "worst error {worst:e} (gross error 1e-3)");
+    }
 }
