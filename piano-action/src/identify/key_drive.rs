@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use mbs_identify::{Camera, Dataset, MarkerSpec, Rng, Role, RunData, RunSpec, SCHEMA_VERSION};
 use serde::Serialize;
 
-use super::synth::{TrackingNoise, tracked};
+use super::synth::{TrackingNoise, check_camera, tracked};
 use crate::ModelKind;
 use crate::error::{PianoError, Result};
 use crate::key::KeyGeometry;
@@ -101,6 +101,18 @@ impl Default for KeyDriveOptions {
             outlier_sigmas: 10.0,
             lost_fraction: 0.001,
             nuisance: true,
+        }
+    }
+}
+
+impl KeyDriveOptions {
+    fn noise(&self) -> TrackingNoise {
+        TrackingNoise {
+            sigma_m: self.sigma_m,
+            rho: self.rho,
+            outlier_fraction: self.outlier_fraction,
+            outlier_sigmas: self.outlier_sigmas,
+            lost_fraction: self.lost_fraction,
         }
     }
 }
@@ -190,26 +202,7 @@ fn check(o: &KeyDriveOptions) -> Result<()> {
     if !(o.duration_s.is_finite() && (0.05..=2.0).contains(&o.duration_s)) {
         return bad("--duration", format!("{} s: 0.05 to 2 s", o.duration_s));
     }
-    if !(o.fps.is_finite() && (100.0..=100_000.0).contains(&o.fps)) {
-        return bad("--fps", format!("{}: 100 to 100000 frames/s", o.fps));
-    }
-    if !(o.exposure_s.is_finite() && o.exposure_s >= 0.0 && o.exposure_s <= 1.0 / o.fps) {
-        return bad("--exposure", format!("{} s: 0 to one frame", o.exposure_s));
-    }
-    if !(o.sigma_m.is_finite() && o.sigma_m > 0.0 && o.sigma_m < 1e-2) {
-        return bad("--sigma", format!("{} m: positive, below 1 cm", o.sigma_m));
-    }
-    if !(o.rho.is_finite() && (0.0..0.99).contains(&o.rho)) {
-        return bad("--rho", format!("{}: 0 to 0.99", o.rho));
-    }
-    for (flag, v) in [
-        ("--outliers", o.outlier_fraction),
-        ("--lost", o.lost_fraction),
-    ] {
-        if !(v.is_finite() && (0.0..=0.2).contains(&v)) {
-            return bad(flag, format!("{v}: a fraction from 0 to 0.2"));
-        }
-    }
+    check_camera(o.fps, o.exposure_s, &o.noise())?;
     Ok(())
 }
 
@@ -295,13 +288,7 @@ pub fn synthesize(
     let markers = default_markers(params, options.sigma_m);
     let frames = (options.duration_s * options.fps).round() as usize;
     let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.fps).collect();
-    let noise = TrackingNoise {
-        sigma_m: options.sigma_m,
-        rho: options.rho,
-        outlier_fraction: options.outlier_fraction,
-        outlier_sigmas: options.outlier_sigmas,
-        lost_fraction: options.lost_fraction,
-    };
+    let noise = options.noise();
     let (mut specs, mut runs, mut truth_runs) = (Vec::new(), Vec::new(), Vec::new());
     for (i, &height) in options.release_heights_m.iter().enumerate() {
         let id = run_id(height);

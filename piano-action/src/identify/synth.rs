@@ -149,6 +149,36 @@ impl SynthOptions {
 /// Per marker, per frame: a tracked position, or `None` for a lost frame.
 pub(crate) type Tracks = Vec<Vec<Option<[f64; 2]>>>;
 
+/// Checks a synthetic camera: its frame rate, exposure and tracking noise (messages name
+/// the command-line flag).
+pub(crate) fn check_camera(fps: f64, exposure_s: f64, noise: &TrackingNoise) -> Result<()> {
+    let bad = |flag: &str, msg: String| Err(PianoError::option(flag, msg));
+    if !(fps.is_finite() && (100.0..=100_000.0).contains(&fps)) {
+        return bad("--fps", format!("{fps}: 100 to 100000 frames/s"));
+    }
+    if !(exposure_s.is_finite() && exposure_s >= 0.0 && exposure_s <= 1.0 / fps) {
+        return bad("--exposure", format!("{exposure_s} s: 0 to one frame"));
+    }
+    if !(noise.sigma_m.is_finite() && noise.sigma_m > 0.0 && noise.sigma_m < 1e-2) {
+        return bad(
+            "--sigma",
+            format!("{} m: positive, below 1 cm", noise.sigma_m),
+        );
+    }
+    if !(noise.rho.is_finite() && (0.0..0.99).contains(&noise.rho)) {
+        return bad("--rho", format!("{}: 0 to 0.99", noise.rho));
+    }
+    for (flag, v) in [
+        ("--outliers", noise.outlier_fraction),
+        ("--lost", noise.lost_fraction),
+    ] {
+        if !(v.is_finite() && (0.0..=0.2).contains(&v)) {
+            return bad(flag, format!("{v}: a fraction from 0 to 0.2"));
+        }
+    }
+    Ok(())
+}
+
 /// The tracked frames of the clean tracks `clean` (per marker, per frame): AR(1) noise on
 /// each marker's coordinates, then gross errors of `outlier_sigmas` σ on one marker's x, y
 /// or both and lost frames of one marker, each at random frames. Returns the frames, the
@@ -232,26 +262,7 @@ fn check(o: &SynthOptions) -> Result<()> {
     if !(o.duration_s.is_finite() && (0.1..=60.0).contains(&o.duration_s)) {
         return bad("--duration", format!("{} s: 0.1 to 60 s", o.duration_s));
     }
-    if !(o.fps.is_finite() && (100.0..=100_000.0).contains(&o.fps)) {
-        return bad("--fps", format!("{}: 100 to 100000 frames/s", o.fps));
-    }
-    if !(o.exposure_s.is_finite() && o.exposure_s >= 0.0 && o.exposure_s <= 1.0 / o.fps) {
-        return bad("--exposure", format!("{} s: 0 to one frame", o.exposure_s));
-    }
-    if !(o.sigma_m.is_finite() && o.sigma_m > 0.0 && o.sigma_m < 1e-2) {
-        return bad("--sigma", format!("{} m: positive, below 1 cm", o.sigma_m));
-    }
-    if !(o.rho.is_finite() && (0.0..0.99).contains(&o.rho)) {
-        return bad("--rho", format!("{}: 0 to 0.99", o.rho));
-    }
-    for (flag, v) in [
-        ("--outliers", o.outlier_fraction),
-        ("--lost", o.lost_fraction),
-    ] {
-        if !(v.is_finite() && (0.0..=0.2).contains(&v)) {
-            return bad(flag, format!("{v}: a fraction from 0 to 0.2"));
-        }
-    }
+    check_camera(o.fps, o.exposure_s, &o.noise())?;
     if let Some(e) = &o.effect {
         e.validate("--effect")?;
     }
