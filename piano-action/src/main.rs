@@ -1136,7 +1136,7 @@ fn synth(
                 out.display(),
                 options.release_heights_m.len(),
                 options.duration_s,
-                options.fps,
+                options.camera.fps,
                 options.mass_kg,
                 truth.display()
             );
@@ -1170,7 +1170,7 @@ fn synth(
         } else {
             "s"
         },
-        options.fps,
+        options.camera.fps,
         truth.display()
     );
     Ok(())

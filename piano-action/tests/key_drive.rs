@@ -4,6 +4,7 @@
 use mbs_identify::Dataset;
 use piano_action::ActionParams;
 use piano_action::identify::key_drive::{DRIVE_MARKER, EXPERIMENT, KeyDriveOptions, synthesize};
+use piano_action::identify::synth::CameraSynth;
 
 #[test]
 fn a_synthetic_key_drive_dataset_records_the_drop_and_reads_back() {
@@ -67,7 +68,7 @@ fn a_synthetic_key_drive_dataset_records_the_drop_and_reads_back() {
         .sum::<f64>()
         / 19.0;
     assert!(
-        jitter > 1e-6 && jitter < 10.0 * options.sigma_m,
+        jitter > 1e-6 && jitter < 10.0 * options.camera.sigma_m,
         "{jitter:e}"
     );
 
@@ -126,7 +127,10 @@ fn bad_key_drive_options_name_their_flag() {
         ),
         (
             KeyDriveOptions {
-                exposure_s: 1.0,
+                camera: CameraSynth {
+                    exposure_s: 1.0,
+                    ..Default::default()
+                },
                 ..Default::default()
             },
             "--exposure",
@@ -241,9 +245,12 @@ fn replaying_a_key_drive_reproduces_the_markers() {
         (
             KeyDriveOptions {
                 nuisance: false,
-                sigma_m: 1e-7,
-                outlier_fraction: 0.0,
-                lost_fraction: 0.0,
+                camera: CameraSynth {
+                    sigma_m: 1e-7,
+                    outlier_fraction: 0.0,
+                    lost_fraction: 0.0,
+                    ..Default::default()
+                },
                 release_heights_m: vec![0.0],
                 duration_s: 0.1,
                 ..Default::default()
@@ -280,7 +287,7 @@ fn replaying_a_key_drive_reproduces_the_markers() {
         let head = r.rms(m("hammer_head"), 0.0, strike).unwrap() * 1e3;
         eprintln!(
             "σ {:.0e} m: key back {back:.3} mm, hammer head to the strike {head:.3} mm",
-            options.sigma_m
+            options.camera.sigma_m
         );
         assert!(back < back_mm, "key back {back:.3} mm");
         assert!(head < head_mm, "hammer head {head:.3} mm");

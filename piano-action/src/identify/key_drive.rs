@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use mbs_identify::{Camera, Dataset, MarkerSpec, Rng, Role, RunData, RunSpec, SCHEMA_VERSION};
 use serde::Serialize;
 
-use super::synth::{TrackingNoise, check_camera, tracked};
+use super::synth::{CameraSynth, check_camera, tracked};
 use crate::ModelKind;
 use crate::error::{PianoError, Result};
 use crate::key::KeyGeometry;
@@ -66,20 +66,8 @@ pub struct KeyDriveOptions {
     pub release_heights_m: Vec<f64>,
     /// Length of each run (s).
     pub duration_s: f64,
-    /// Frame rate (frames/s) [S]: the seed study filmed at 3000 fps.
-    pub fps: f64,
-    /// Exposure of a frame (s).
-    pub exposure_s: f64,
-    /// Tracking noise, marginal SD per coordinate (m) [D] `identification.md` §5.1.
-    pub sigma_m: f64,
-    /// Lag-one correlation of the tracking noise [D].
-    pub rho: f64,
-    /// Fraction of frames with a gross tracking error.
-    pub outlier_fraction: f64,
-    /// Size of a gross error, in σ.
-    pub outlier_sigmas: f64,
-    /// Fraction of frames lost.
-    pub lost_fraction: f64,
+    /// The camera and its tracker.
+    pub camera: CameraSynth,
     /// Whether the action differs from the parameter file by the nuisance mismatches (off:
     /// the file's action exactly, to check the pipeline).
     pub nuisance: bool,
@@ -93,26 +81,8 @@ impl Default for KeyDriveOptions {
             mass_kg: 1.0,
             release_heights_m: vec![0.0, 0.005],
             duration_s: 0.3,
-            fps: 3000.0,
-            exposure_s: 1.0 / 3000.0,
-            sigma_m: 30e-6,
-            rho: 0.8,
-            outlier_fraction: 0.003,
-            outlier_sigmas: 10.0,
-            lost_fraction: 0.001,
+            camera: CameraSynth::default(),
             nuisance: true,
-        }
-    }
-}
-
-impl KeyDriveOptions {
-    fn noise(&self) -> TrackingNoise {
-        TrackingNoise {
-            sigma_m: self.sigma_m,
-            rho: self.rho,
-            outlier_fraction: self.outlier_fraction,
-            outlier_sigmas: self.outlier_sigmas,
-            lost_fraction: self.lost_fraction,
         }
     }
 }
@@ -202,7 +172,7 @@ fn check(o: &KeyDriveOptions) -> Result<()> {
     if !(o.duration_s.is_finite() && (0.05..=2.0).contains(&o.duration_s)) {
         return bad("--duration", format!("{} s: 0.05 to 2 s", o.duration_s));
     }
-    check_camera(o.fps, o.exposure_s, &o.noise())?;
+    check_camera(&o.camera)?;
     Ok(())
 }
 
@@ -285,16 +255,15 @@ pub fn synthesize(
     } else {
         (params.clone(), BTreeMap::new())
     };
-    let markers = default_markers(params, options.sigma_m);
-    let frames = (options.duration_s * options.fps).round() as usize;
-    let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.fps).collect();
-    let noise = options.noise();
+    let markers = default_markers(params, options.camera.sigma_m);
+    let frames = (options.duration_s * options.camera.fps).round() as usize;
+    let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.camera.fps).collect();
     let (mut specs, mut runs, mut truth_runs) = (Vec::new(), Vec::new(), Vec::new());
     for (i, &height) in options.release_heights_m.iter().enumerate() {
         let id = run_id(height);
         let offset = rng.range(-2.5e-4, 2.5e-4);
         let camera = Camera {
-            exposure_s: options.exposure_s,
+            exposure_s: options.camera.exposure_s,
             offset_s: offset,
         };
         let input = Input::MassDrop {
@@ -322,7 +291,7 @@ pub fn synthesize(
                     .collect()
             })
             .collect();
-        let (positions, outliers, lost) = tracked(&mut rng, clean, &noise);
+        let (positions, outliers, lost) = tracked(&mut rng, clean, &options.camera);
         specs.push(RunSpec {
             id: id.clone(),
             file: format!("{id}.csv"),
@@ -355,8 +324,8 @@ pub fn synthesize(
              is hidden in it is in the truth file)",
             options.mass_kg, options.seed
         ),
-        fps: options.fps,
-        exposure_s: options.exposure_s,
+        fps: options.camera.fps,
+        exposure_s: options.camera.exposure_s,
         markers,
         drive: Some(DRIVE_MARKER.into()),
         runs: specs,
@@ -365,7 +334,7 @@ pub fn synthesize(
         experiment: EXPERIMENT.into(),
         seed: options.seed,
         nuisance,
-        sigma_m: options.sigma_m,
+        sigma_m: options.camera.sigma_m,
         runs: truth_runs,
     };
     Ok((dataset, runs, truth))

@@ -26,6 +26,25 @@ pub struct SynthOptions {
     pub releases_deg: Vec<f64>,
     /// Length of each run (s).
     pub duration_s: f64,
+    /// The camera and its tracker.
+    pub camera: CameraSynth,
+}
+
+impl Default for SynthOptions {
+    fn default() -> Self {
+        Self {
+            effect: None,
+            seed: 0,
+            releases_deg: vec![0.0, -35.0],
+            duration_s: 4.0,
+            camera: CameraSynth::default(),
+        }
+    }
+}
+
+/// A synthetic camera and its tracker: what films the markers of a synthetic dataset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSynth {
     /// Frame rate (frames/s) [S]: the seed study filmed at 3000 fps.
     pub fps: f64,
     /// Exposure of a frame (s): a full frame by default, the strongest blur.
@@ -42,13 +61,9 @@ pub struct SynthOptions {
     pub lost_fraction: f64,
 }
 
-impl Default for SynthOptions {
+impl Default for CameraSynth {
     fn default() -> Self {
         Self {
-            effect: None,
-            seed: 0,
-            releases_deg: vec![0.0, -35.0],
-            duration_s: 4.0,
             fps: 3000.0,
             exposure_s: 1.0 / 3000.0,
             sigma_m: 30e-6,
@@ -119,39 +134,10 @@ pub fn default_markers(sigma_m: f64) -> Vec<MarkerSpec> {
     ]
 }
 
-/// What a camera tracker adds to the clean marker tracks.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct TrackingNoise {
-    /// Marginal SD per coordinate (m).
-    pub sigma_m: f64,
-    /// Lag-one correlation.
-    pub rho: f64,
-    /// Fraction of frames with a gross error.
-    pub outlier_fraction: f64,
-    /// Size of a gross error, in σ.
-    pub outlier_sigmas: f64,
-    /// Fraction of frames lost.
-    pub lost_fraction: f64,
-}
-
-impl SynthOptions {
-    fn noise(&self) -> TrackingNoise {
-        TrackingNoise {
-            sigma_m: self.sigma_m,
-            rho: self.rho,
-            outlier_fraction: self.outlier_fraction,
-            outlier_sigmas: self.outlier_sigmas,
-            lost_fraction: self.lost_fraction,
-        }
-    }
-}
-
-/// Per marker, per frame: a tracked position, or `None` for a lost frame.
-pub(crate) type Tracks = Vec<Vec<Option<[f64; 2]>>>;
-
 /// Checks a synthetic camera: its frame rate, exposure and tracking noise (messages name
 /// the command-line flag).
-pub(crate) fn check_camera(fps: f64, exposure_s: f64, noise: &TrackingNoise) -> Result<()> {
+pub(crate) fn check_camera(camera: &CameraSynth) -> Result<()> {
+    let (fps, exposure_s, noise) = (camera.fps, camera.exposure_s, camera);
     let bad = |flag: &str, msg: String| Err(PianoError::option(flag, msg));
     if !(fps.is_finite() && (100.0..=100_000.0).contains(&fps)) {
         return bad("--fps", format!("{fps}: 100 to 100000 frames/s"));
@@ -179,6 +165,9 @@ pub(crate) fn check_camera(fps: f64, exposure_s: f64, noise: &TrackingNoise) -> 
     Ok(())
 }
 
+/// Per marker, per frame: a tracked position, or `None` for a lost frame.
+pub(crate) type Tracks = Vec<Vec<Option<[f64; 2]>>>;
+
 /// The tracked frames of the clean tracks `clean` (per marker, per frame): AR(1) noise on
 /// each marker's coordinates, then gross errors of `outlier_sigmas` σ on one marker's x, y
 /// or both and lost frames of one marker, each at random frames. Returns the frames, the
@@ -186,7 +175,7 @@ pub(crate) fn check_camera(fps: f64, exposure_s: f64, noise: &TrackingNoise) -> 
 pub(crate) fn tracked(
     rng: &mut Rng,
     clean: Vec<Vec<[f64; 2]>>,
-    noise: &TrackingNoise,
+    noise: &CameraSynth,
 ) -> (Tracks, Vec<usize>, Vec<usize>) {
     let frames = clean.first().map_or(0, Vec::len);
     let mut positions = Vec::new();
@@ -262,7 +251,7 @@ fn check(o: &SynthOptions) -> Result<()> {
     if !(o.duration_s.is_finite() && (0.1..=60.0).contains(&o.duration_s)) {
         return bad("--duration", format!("{} s: 0.1 to 60 s", o.duration_s));
     }
-    check_camera(o.fps, o.exposure_s, &o.noise())?;
+    check_camera(&o.camera)?;
     if let Some(e) = &o.effect {
         e.validate("--effect")?;
     }
@@ -285,9 +274,9 @@ pub fn synthesize(
     model.coulomb_n_m *= 1.0 + rng.range(-0.10, 0.10);
     // A finer step than the diagnosis uses, so it does not fit its own integration error.
     model.step_s /= 4.0;
-    let markers = default_markers(options.sigma_m);
-    let frames = (options.duration_s * options.fps).round() as usize;
-    let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.fps).collect();
+    let markers = default_markers(options.camera.sigma_m);
+    let frames = (options.duration_s * options.camera.fps).round() as usize;
+    let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.camera.fps).collect();
     let mut specs = Vec::new();
     let mut runs = Vec::new();
     let mut truth_runs = Vec::new();
@@ -296,7 +285,7 @@ pub fn synthesize(
         let true_release = release + rng.range(-0.5, 0.5);
         let offset = rng.range(-2.5e-4, 2.5e-4);
         let camera = Camera {
-            exposure_s: options.exposure_s,
+            exposure_s: options.camera.exposure_s,
             offset_s: offset,
         };
         let path = model.simulate(true_release.to_radians(), options.duration_s + 0.01);
@@ -304,7 +293,7 @@ pub fn synthesize(
             .iter()
             .map(|m| path.frames(&camera, &times, m.local_m))
             .collect();
-        let (positions, outliers, lost) = tracked(&mut rng, clean, &options.noise());
+        let (positions, outliers, lost) = tracked(&mut rng, clean, &options.camera);
         specs.push(RunSpec {
             id: id.clone(),
             file: format!("{id}.csv"),
@@ -335,8 +324,8 @@ pub fn synthesize(
              the truth file)",
             options.seed
         ),
-        fps: options.fps,
-        exposure_s: options.exposure_s,
+        fps: options.camera.fps,
+        exposure_s: options.camera.exposure_s,
         markers,
         drive: None,
         runs: specs,
@@ -348,8 +337,8 @@ pub fn synthesize(
         mass_kg: model.mass_kg,
         inertia_com_kg_m2: model.inertia_com_kg_m2,
         coulomb_n_m: model.coulomb_n_m,
-        sigma_m: options.sigma_m,
-        rho: options.rho,
+        sigma_m: options.camera.sigma_m,
+        rho: options.camera.rho,
         runs: truth_runs,
     };
     Ok((dataset, runs, truth))
