@@ -291,5 +291,29 @@ fn replaying_a_key_drive_reproduces_the_markers() {
         );
         assert!(back < back_mm, "key back {back:.3} mm");
         assert!(head < head_mm, "hammer head {head:.3} mm");
+        // The functional sequence, phase by phase, in order.
+        let names: Vec<&str> = r.phases.iter().map(|p| p.name).collect();
+        assert_eq!(
+            names[..6],
+            [
+                "rise",
+                "let_off",
+                "free_flight",
+                "string_contact",
+                "rebound",
+                "check"
+            ],
+            "{names:?}"
+        );
+        assert!(r.phases.windows(2).all(|w| w[0].to_s == w[1].from_s));
+        if options.camera.sigma_m < 1e-6 {
+            // With a near-perfect camera, no phase of the hammer head is off by 0.5 mm,
+            // and no disagreement starts.
+            for (phase, rms) in r.phase_rms(m("hammer_head")) {
+                let rms = rms.unwrap_or(0.0) * 1e3;
+                assert!(rms < 0.5, "{phase}: {rms:.3} mm");
+            }
+            assert_eq!(r.onset(m("hammer_head"), 5e-4, 10), None);
+        }
     }
 }

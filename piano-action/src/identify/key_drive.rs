@@ -422,9 +422,99 @@ pub struct Replay {
     pub residual_m: Vec<Vec<Option<f64>>>,
     /// The model's events in the replay (name, time).
     pub events: Vec<(String, f64)>,
+    /// The phases of the functional sequence in the replay, in order.
+    pub phases: Vec<Phase>,
+}
+
+/// A phase of the functional sequence: `[from_s, to_s)` of the replay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Phase {
+    /// `rise`, `let_off`, `free_flight`, `string_contact`, `rebound`, `check` or
+    /// `post_check`.
+    pub name: &'static str,
+    /// Start (s).
+    pub from_s: f64,
+    /// End (s).
+    pub to_s: f64,
+}
+
+/// The phases from a replay's key moments: let-off (the jack's toe on its button), escape
+/// (the jack leaving the knuckle), the string contact's start and end, the check's catch
+/// and its release. A moment that does not happen ends the sequence there: the last phase
+/// reached runs to `end`.
+fn phases(
+    let_off: Option<f64>,
+    escape: Option<f64>,
+    strike: Option<(f64, f64)>,
+    check: Option<(f64, Option<f64>)>,
+    end: f64,
+) -> Vec<Phase> {
+    let marks: [(&'static str, Option<f64>); 7] = [
+        ("rise", Some(0.0)),
+        ("let_off", let_off),
+        ("free_flight", escape),
+        ("string_contact", strike.map(|s| s.0)),
+        ("rebound", strike.map(|s| s.1)),
+        ("check", check.map(|c| c.0)),
+        ("post_check", check.and_then(|c| c.1)),
+    ];
+    let mut out: Vec<Phase> = Vec::new();
+    for (name, start) in marks {
+        let Some(start) = start else { break };
+        if let Some(last) = out.last_mut() {
+            if start < last.from_s {
+                break;
+            }
+            last.to_s = start;
+        }
+        out.push(Phase {
+            name,
+            from_s: start,
+            to_s: end,
+        });
+    }
+    out
 }
 
 impl Replay {
+    /// Each phase's RMS residual (m) of marker `m` (`None` for a phase without a seen
+    /// frame).
+    pub fn phase_rms(&self, m: usize) -> Vec<(&'static str, Option<f64>)> {
+        self.phases
+            .iter()
+            .map(|p| (p.name, self.rms(m, p.from_s, p.to_s)))
+            .collect()
+    }
+
+    /// When marker `m`'s residual first stays above `threshold_m` for `frames` seen frames
+    /// in a row, and the phase it falls in: the onset of a disagreement.
+    pub fn onset(&self, m: usize, threshold_m: f64, frames: usize) -> Option<(f64, &'static str)> {
+        let mut run = 0;
+        let mut start = None;
+        for (t, r) in self.time_s.iter().zip(&self.residual_m[m]) {
+            let Some(r) = r else { continue };
+            if *r > threshold_m {
+                if run == 0 {
+                    start = Some(*t);
+                }
+                run += 1;
+                if run >= frames.max(1) {
+                    let t0 = start?;
+                    let phase = self
+                        .phases
+                        .iter()
+                        .rev()
+                        .find(|p| p.from_s <= t0)
+                        .map_or("rise", |p| p.name);
+                    return Some((t0, phase));
+                }
+            } else {
+                run = 0;
+            }
+        }
+        None
+    }
+
     /// The RMS residual (m) of marker `m` over the frames with `from ≤ t < to`.
     pub fn rms(&self, m: usize, from: f64, to: f64) -> Option<f64> {
         let (mut sum, mut count) = (0.0, 0usize);
@@ -504,6 +594,36 @@ pub fn replay(
     let duration = run.time_s[run.time_s.len() - 1] - run.time_s[0];
     let input = Input::Motion { points };
     let sim = simulate(params, kind, &input, duration, 2e-5)?;
+    // The escape: the jack leaving the knuckle after the let-off (the knuckle contact's
+    // gap rising through zero).
+    let knuckle = prepare(params, kind, &input)?
+        .action
+        .contacts
+        .get("jack_knuckle")
+        .copied();
+    let first = |name: &str, after: f64| {
+        sim.events
+            .iter()
+            .find(|e| e.name == name && e.time_s >= after)
+            .map(|e| e.time_s)
+    };
+    let let_off = first("let_off", 0.0);
+    let escape = let_off.and_then(|l| {
+        sim.solution
+            .events
+            .iter()
+            .find(|e| {
+                e.time >= l
+                    && e.direction == mbs_integrators::Crossing::Rising
+                    && e.source.map(|s| s.element) == knuckle
+            })
+            .map(|e| e.time)
+    });
+    let strike = first("string_contact_start", 0.0)
+        .and_then(|s| first("string_contact_end", s).map(|e| (s, e)));
+    let check = strike
+        .and_then(|(_, e)| first("check_catch", e))
+        .map(|c| (c, first("check_release", c)));
     let (sim_t, tracks) = marker_tracks_of(params, kind, &input, &sim, &dataset.markers)?;
     let camera = Camera {
         exposure_s: dataset.exposure_s,
@@ -543,12 +663,43 @@ pub fn replay(
             .iter()
             .map(|e| (e.name.to_string(), e.time_s))
             .collect(),
+        phases: phases(let_off, escape, strike, check, duration),
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn phases_follow_the_sequence_and_stop_where_it_stops() {
+        let p = phases(
+            Some(0.02),
+            Some(0.021),
+            Some((0.025, 0.027)),
+            Some((0.03, Some(0.08))),
+            0.3,
+        );
+        let names: Vec<&str> = p.iter().map(|p| p.name).collect();
+        assert_eq!(
+            names,
+            [
+                "rise",
+                "let_off",
+                "free_flight",
+                "string_contact",
+                "rebound",
+                "check",
+                "post_check"
+            ]
+        );
+        assert!(p.windows(2).all(|w| w[0].to_s == w[1].from_s));
+        assert_eq!((p[0].from_s, p[6].to_s), (0.0, 0.3));
+        // No escape (a blocked jack): the let-off phase runs to the end.
+        let p = phases(Some(0.02), None, Some((0.025, 0.027)), None, 0.3);
+        assert_eq!(p.len(), 2);
+        assert_eq!((p[1].name, p[1].to_s), ("let_off", 0.3));
+    }
 
     /// A smooth motion with a gross error and lost frames comes back smooth: the error
     /// does not pull the neighbours, the lost frames are filled.
