@@ -1,6 +1,9 @@
 //! Synthetic key-drive datasets (issue 15, the seed's second experiment): a 1 kg mass on
 //! the key, every marker through the camera model, the key front named as the drive.
 
+mod common;
+
+use common::piano;
 use mbs_identify::Dataset;
 use piano_action::ActionParams;
 use piano_action::identify::key_drive::{DRIVE_MARKER, EXPERIMENT, KeyDriveOptions, synthesize};
@@ -139,18 +142,6 @@ fn bad_key_drive_options_name_their_flag() {
         let e = synthesize(&params, &options).unwrap_err();
         assert_eq!(e.field(), flag, "{e}");
     }
-}
-
-fn piano(args: &[&str]) -> (bool, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_piano"))
-        .args(args)
-        .output()
-        .expect("piano runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 #[test]
