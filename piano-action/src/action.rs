@@ -32,6 +32,11 @@ use mbs_mechanism::ContactHandle;
 use crate::error::Result;
 use crate::params::{ActionParams, ContactParams};
 
+/// A change to the grand's description before it is built: an effect a diagnosis adds
+/// (see [`Action::build_transformed`]).
+pub type Transform<'a> =
+    &'a (dyn Fn(&mbs_mechanism::Mechanism) -> Result<mbs_mechanism::Mechanism> + Sync);
+
 /// Which of the three progressive models.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum ModelKind {
@@ -127,6 +132,18 @@ impl Action {
         kind: ModelKind,
         presser: Option<Presser>,
     ) -> Result<Action> {
+        Self::build_transformed(params, kind, presser, None)
+    }
+
+    /// Assembles `kind` like [`Action::build_with`], its description first changed by
+    /// `transform` if given (an effect added for a diagnosis: a body split, a contact's law
+    /// swapped).
+    pub fn build_transformed(
+        params: &ActionParams,
+        kind: ModelKind,
+        presser: Option<Presser>,
+        transform: Option<Transform<'_>>,
+    ) -> Result<Action> {
         params.validate()?;
         if let Some(pr) = presser
             && !(pr.mass_kg.is_finite()
@@ -143,7 +160,10 @@ impl Action {
             ));
         }
         let mechanism = crate::describe::grand_mechanism(params, kind, presser)?;
-        Self::from_mechanism(params, kind, presser, &mechanism)
+        match transform {
+            None => Self::from_mechanism(params, kind, presser, &mechanism),
+            Some(f) => Self::from_mechanism(params, kind, presser, &f(&mechanism)?),
+        }
     }
 
     /// Assembles the action from `mechanism`, a description of the grand `kind` (as
@@ -248,10 +268,15 @@ impl Action {
     }
 
     fn settle(params: &ActionParams, kind: ModelKind) -> Result<Vec<f64>> {
-        let action = Action::build(params, kind)?;
-        let x0 = action.layout_state()?;
-        let settled = action.integrate(&x0, 0.3, 2e-3, Some(0.3))?;
-        let nv = action.system.model().nv();
+        Action::build(params, kind)?.settled_coordinates()
+    }
+
+    /// The coordinates of this action settled at rest from its layout state, as
+    /// [`Action::rest_coordinates`] settles the parameter file's (not remembered).
+    pub fn settled_coordinates(&self) -> Result<Vec<f64>> {
+        let x0 = self.layout_state()?;
+        let settled = self.integrate(&x0, 0.3, 2e-3, Some(0.3))?;
+        let nv = self.system.model().nv();
         let last = settled.len().saturating_sub(1);
         Ok(settled.state(last)[..nv].to_vec())
     }

@@ -7,7 +7,7 @@ use mbs_integrators::Solution;
 
 use mbs_core::elements::{AppliedLoad, Attachment, JointSpringDamper, LoadFrame, SpringLaw};
 
-use crate::action::{Action, ModelKind, Presser};
+use crate::action::{Action, ModelKind, Presser, Transform};
 use crate::error::{PianoError, Result};
 use crate::params::{ActionParams, ContactParams};
 
@@ -417,6 +417,17 @@ pub struct Prepared {
 /// Assembles `kind` with what `input` adds (a presser and its forces, a key force or a
 /// key drive) and the starting state, settled at rest; the input is checked first.
 pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<Prepared> {
+    prepare_transformed(params, kind, input, None)
+}
+
+/// Assembles like [`prepare`], the grand's description changed by `transform` if given
+/// (an effect a diagnosis adds); the rest is then settled on the changed action.
+pub fn prepare_transformed(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    transform: Option<Transform<'_>>,
+) -> Result<Prepared> {
     input.validate()?;
     let presser = match *input {
         Input::MassDrop { mass_kg, height_m } => Some(Presser::weight(mass_kg, height_m * 1e3)),
@@ -433,9 +444,14 @@ pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<
     };
     // Start from the action settled at rest (the presser, if any, last, with its pad where
     // the layout put it relative to the key top).
-    let rest = Action::rest_coordinates(params, kind)?;
+    let rest = match transform {
+        None => Action::rest_coordinates(params, kind)?,
+        Some(_) => {
+            Action::build_transformed(params, kind, None, transform)?.settled_coordinates()?
+        }
+    };
     let rest_depth_mm = key_depth_mm(params, rest[0]);
-    let mut action = Action::build_with(params, kind, presser)?;
+    let mut action = Action::build_transformed(params, kind, presser, transform)?;
     let model = action.system.model().clone();
     let nv = model.nv();
     let mut q0 = rest.clone();
@@ -561,12 +577,34 @@ pub fn simulate_observed(
     output_step_s: f64,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Run> {
+    simulate_transformed(
+        params,
+        kind,
+        input,
+        duration_s,
+        output_step_s,
+        None,
+        progress,
+    )
+}
+
+/// Simulates like [`simulate_observed`], the grand's description changed by `transform`
+/// if given (see [`prepare_transformed`]).
+pub fn simulate_transformed(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    duration_s: f64,
+    output_step_s: f64,
+    transform: Option<Transform<'_>>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Run> {
     check_duration(duration_s, output_step_s)?;
     let Prepared {
         action,
         x0,
         rest_depth_mm,
-    } = prepare(params, kind, input)?;
+    } = prepare_transformed(params, kind, input, transform)?;
     let model = action.system.model().clone();
     let nv = model.nv();
     let solution =

@@ -3,6 +3,7 @@
 //! diagnosis that finds, names and adds a missing effect (issue 13; the generic parts are
 //! in `mbs-identify`).
 
+pub mod action_effects;
 pub mod commands;
 mod data_check;
 pub mod diagnose;

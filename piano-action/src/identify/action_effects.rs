@@ -1,0 +1,487 @@
+//! The action family of effects (issue 15): what a grand action driven by a weighted key
+//! may be missing after the check, and before it. Each adds itself to the grand's
+//! mechanism description through a transformation (`mbs_mechanism::transform`), so the
+//! integrator and the contact code are untouched:
+//!
+//! | id | transformation | parameters (null) |
+//! |---|---|---|
+//! | `key_flex` | `split_body` of the key 20 mm behind the balance pivot: the back arm (capstan, back-check, back rail) on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
+//! | `shank_flex` | `split_body` of the hammer at the head's root, 110 mm along the shank: the head (crown, tail) on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
+//! | `backcheck_compliance` | `mount_compliant` of the back-check's face on a wire rooted on the key: a body `backcheck` on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
+//! | `keybed_felt` | `swap_law` of the front-rail punching: its stiffness scaled, its restitution set | `k_scale` (1), `e` |
+//! | `felt_hysteresis` | `swap_law` of the knuckle's felt: its restitution (loading against unloading) shifted | `de` (0) |
+//! | `knuckle_friction` | `swap_friction` of the jack–knuckle contact: its friction coefficient raised | `dmu` (0) |
+//!
+//! A flex's damping is given by its ratio ζ: c = 2 ζ √(k I), I the moving part's inertia
+//! about its new joint. The geometry of each cut and mount (where the key bends, the
+//! head's mass) is estimated [D] and documented on its constant.
+
+use mbs_identify::{EffectParam, EffectSpec};
+use mbs_mechanism::{ContactFrictionSpec, Flex, LawSpec, MassProps, Mechanism, Side};
+
+use crate::error::{PianoError, Result};
+use crate::params::ActionParams;
+
+/// The key bends: its back arm on a torsion spring 20 mm behind the balance pivot. Range
+/// [D] `identification.md` §3.5: a basswood key (EI ≈ 200 N·m²) over its 0.2 m back arm
+/// is about 3 EI/L ≈ 3000 N·m/rad at the rail; the plausible range allows 30 times softer
+/// (a cracked or thin key) and 30 times stiffer.
+pub const KEY_FLEX: EffectSpec = EffectSpec {
+    id: "key_flex",
+    summary: "the key bends: its back arm turns on a torsion spring near the balance rail",
+    params: &[
+        EffectParam {
+            name: "compliance_rad_n_m",
+            unit: "rad/(N·m)",
+            null: Some(0.0),
+            range: [1e-5, 1e-2],
+            typical: 2.5e-3,
+            log_scale: true,
+        },
+        ZETA,
+    ],
+    confusable_with: &["backcheck_compliance", "keybed_felt", "shank_flex"],
+    discriminating_experiment: "track the key's back end (or the capstan) as well as its \
+        front: only a bending key moves them apart",
+};
+
+/// The hammer shank bends: the head on a torsion spring at its root. Range [D]: a
+/// hornbeam shank (d ≈ 8 mm, EI ≈ 2 N·m²) is some 40 N·m/rad at the head's root; the
+/// range allows 10 times stiffer and 80 times softer.
+pub const SHANK_FLEX: EffectSpec = EffectSpec {
+    id: "shank_flex",
+    summary: "the hammer shank bends: the head turns on a torsion spring at its root",
+    params: &[
+        EffectParam {
+            name: "compliance_rad_n_m",
+            unit: "rad/(N·m)",
+            null: Some(0.0),
+            range: [2.5e-3, 2.0],
+            typical: 0.25,
+            log_scale: true,
+        },
+        ZETA,
+    ],
+    confusable_with: &["backcheck_compliance", "key_flex"],
+    discriminating_experiment: "track two points on the hammer, the head and the middle of \
+        the shank: only a bending shank moves them apart",
+};
+
+/// The back-check on a compliant wire. Range [D]: a 2.5 mm steel wire 50 mm long (EI ≈
+/// 0.4 N·m²) is about 3 EI/L ≈ 23 N·m/rad at its root; the range allows 20 times softer
+/// (a bent, loose wire) and 40 times stiffer.
+pub const BACKCHECK_COMPLIANCE: EffectSpec = EffectSpec {
+    id: "backcheck_compliance",
+    summary: "the back-check sits on a compliant wire: it gives under the caught hammer",
+    params: &[
+        EffectParam {
+            name: "compliance_rad_n_m",
+            unit: "rad/(N·m)",
+            null: Some(0.0),
+            range: [1e-3, 1.0],
+            typical: 0.1,
+            log_scale: true,
+        },
+        ZETA,
+    ],
+    confusable_with: &["key_flex", "shank_flex"],
+    discriminating_experiment: "track the back-check's head: only a compliant wire moves it \
+        relative to the key",
+};
+
+/// The front-rail punching differs from the file: its stiffness scaled, its restitution
+/// changed. Range [D]: punchings run from soft new felt to hard, compressed old felt,
+/// a factor 20 either way around the file's.
+pub const KEYBED_FELT: EffectSpec = EffectSpec {
+    id: "keybed_felt",
+    summary: "the front-rail punching's stiffness and restitution differ from the file",
+    params: &[
+        EffectParam {
+            name: "k_scale",
+            unit: "",
+            null: Some(1.0),
+            range: [0.05, 20.0],
+            typical: 0.1,
+            log_scale: true,
+        },
+        EffectParam {
+            name: "e",
+            unit: "",
+            null: None,
+            range: [0.05, 0.95],
+            typical: 0.4,
+            log_scale: false,
+        },
+    ],
+    confusable_with: &["key_flex"],
+    discriminating_experiment: "change the mass on the key: the key bottoms on the punching \
+        at a frequency √(k/m) that follows the load",
+};
+
+/// The knuckle felt's loading and unloading differ from the file's: its restitution
+/// shifted by `de`. Range [D]: action felts restitute 0.2–0.8.
+pub const FELT_HYSTERESIS: EffectSpec = EffectSpec {
+    id: "felt_hysteresis",
+    summary: "the knuckle's felt loses more (or less) between loading and unloading than \
+        the file says",
+    params: &[EffectParam {
+        name: "de",
+        unit: "",
+        null: Some(0.0),
+        range: [-0.35, 0.5],
+        typical: -0.3,
+        log_scale: false,
+    }],
+    confusable_with: &["knuckle_friction"],
+    discriminating_experiment: "drop the mass from two heights: felt hysteresis grows with \
+        the knuckle's compression, friction with the jack's slide",
+};
+
+/// Extra friction at the jack–knuckle contact. Range [D]: dry buckskin or a worn knuckle
+/// up to μ ≈ 0.75 (the file's 0.15 plus 0.6).
+pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
+    id: "knuckle_friction",
+    summary: "the jack slides on the knuckle with more friction than the file says",
+    params: &[EffectParam {
+        name: "dmu",
+        unit: "",
+        null: Some(0.0),
+        range: [0.0, 0.6],
+        typical: 0.3,
+        log_scale: false,
+    }],
+    confusable_with: &["felt_hysteresis"],
+    discriminating_experiment: "drop the mass from two heights: friction follows the jack's \
+        slide under the knuckle, felt hysteresis its compression",
+};
+
+/// A flex's damping ratio [D]: wood and felt joints ring with ζ of a few per cent.
+const ZETA: EffectParam = EffectParam {
+    name: "zeta",
+    unit: "",
+    null: None,
+    range: [0.005, 0.5],
+    typical: 0.05,
+    log_scale: true,
+};
+
+/// The action family, in the order a diagnosis tries them.
+pub const ACTION_EFFECTS: [EffectSpec; 6] = [
+    KEY_FLEX,
+    SHANK_FLEX,
+    BACKCHECK_COMPLIANCE,
+    KEYBED_FELT,
+    FELT_HYSTERESIS,
+    KNUCKLE_FRICTION,
+];
+
+/// The spec of action effect `id`.
+pub fn action_effect_spec(id: &str) -> Option<&'static EffectSpec> {
+    ACTION_EFFECTS.iter().find(|e| e.id == id)
+}
+
+/// The ids of the action family, for messages.
+pub fn action_library_ids() -> String {
+    ACTION_EFFECTS.map(|e| e.id).join(", ")
+}
+
+/// Where the key bends [D]: 20 mm behind the balance pivot (the balance hole's wood stays
+/// whole), the cut across the key.
+const KEY_CUT_M: [f64; 2] = [0.02, 0.0];
+/// The back arm's share of the key's mass [D]: the front arm carries the lead weights.
+const KEY_BACK_MASS_SHARE: f64 = 0.27;
+/// Where the shank meets the head, along the shank from the flange pin (m) [D]: the
+/// moulding spans 115–140 mm around the 132 mm strike point.
+const HEAD_ROOT_M: [f64; 2] = [0.11, 0.0];
+/// The head's share of the hammer's mass [D]: felt and moulding some 8 g of the 11.74 g.
+const HEAD_MASS_SHARE: f64 = 0.68;
+/// The head's centre of mass in the hammer frame (m) [D]: the moulding's middle.
+const HEAD_COM_M: [f64; 2] = [0.12, 0.014];
+/// The head's inertia about its centre of mass (kg·m²) [D]: 8 g over about 50 × 25 mm.
+const HEAD_INERTIA_KG_M2: f64 = 2.0e-6;
+/// The back-check's mass (kg) [M]: wire, wooden head and felt.
+const BACKCHECK_MASS_KG: f64 = 0.006;
+/// Its inertia about its centre of mass (kg·m²) [D]: 6 g over a 30 × 20 mm head.
+const BACKCHECK_INERTIA_KG_M2: f64 = 6.0e-7;
+/// Where its wire enters the key, below the face's centre (m) [D]: the key's top.
+const BACKCHECK_WIRE_ROOT_Y_M: f64 = 0.019;
+
+/// Where a split effect cuts: the body, the cut point and direction (toward the part that
+/// goes), the new body.
+struct Cut {
+    body: &'static str,
+    at: [f64; 2],
+    along: [f64; 2],
+    new_body: &'static str,
+}
+
+/// The cut of `key_flex` or `shank_flex`.
+fn cut_of(id: &str) -> Option<Cut> {
+    match id {
+        "key_flex" => Some(Cut {
+            body: "key",
+            at: KEY_CUT_M,
+            along: [1.0, 0.0],
+            new_body: "key_back_arm",
+        }),
+        "shank_flex" => Some(Cut {
+            body: "hammer",
+            at: HEAD_ROOT_M,
+            along: [1.0, 0.0],
+            new_body: "hammer_head",
+        }),
+        _ => None,
+    }
+}
+
+/// The body and local point (m) that a marker given on `body` at `local_m` (in the
+/// parameter file's body frames) rides on once `effect_id` is added: a split moves the
+/// points beyond its cut onto the new body, in its frame.
+pub fn marker_body(effect_id: Option<&str>, body: &str, local_m: [f64; 2]) -> (String, [f64; 2]) {
+    if let Some(cut) = effect_id.and_then(cut_of)
+        && cut.body == body
+    {
+        let d = [local_m[0] - cut.at[0], local_m[1] - cut.at[1]];
+        if d[0] * cut.along[0] + d[1] * cut.along[1] > 0.0 {
+            return (cut.new_body.to_string(), d);
+        }
+    }
+    (body.to_string(), local_m)
+}
+
+/// A flex's spring from its compliance and damping ratio, `inertia` the moving part's
+/// about its joint.
+fn flex(compliance: f64, zeta: f64, inertia: f64) -> Flex {
+    let k = 1.0 / compliance;
+    Flex {
+        stiffness: k,
+        damping: 2.0 * zeta * (k * inertia).sqrt(),
+    }
+}
+
+fn bad(id: &str, message: String) -> PianoError {
+    PianoError::Simulation(format!("effect {id}: {message}"))
+}
+
+/// The value of parameter `name` of `spec` in `values` (laid out as `spec.params`).
+fn value(spec: &EffectSpec, values: &[f64], name: &str) -> Result<f64> {
+    spec.params
+        .iter()
+        .position(|p| p.name == name)
+        .and_then(|i| values.get(i).copied())
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| bad(spec.id, format!("needs a finite `{name}`")))
+}
+
+/// Whether `values` are the effect's null (it changes nothing).
+pub fn is_null(spec: &EffectSpec, values: &[f64]) -> bool {
+    match (spec.params.first().and_then(|p| p.null), values.first()) {
+        (Some(null), Some(v)) => *v == null,
+        _ => false,
+    }
+}
+
+/// `mechanism` (the grand of `params`) with effect `spec` at `values` added.
+pub fn apply(
+    mechanism: &Mechanism,
+    spec: &EffectSpec,
+    values: &[f64],
+    params: &ActionParams,
+) -> Result<Mechanism> {
+    if is_null(spec, values) {
+        return Ok(mechanism.clone());
+    }
+    let body = |name: &str| {
+        mechanism
+            .bodies
+            .iter()
+            .find(|b| b.name == name)
+            .ok_or_else(|| bad(spec.id, format!("the action has no body '{name}'")))
+    };
+    let out = match spec.id {
+        "key_flex" | "shank_flex" => {
+            let c = value(spec, values, "compliance_rad_n_m")?;
+            let zeta = value(spec, values, "zeta")?;
+            if c <= 0.0 {
+                return Err(bad(spec.id, format!("compliance {c} must be positive")));
+            }
+            let cut = cut_of(spec.id).ok_or_else(|| bad(spec.id, "no cut".into()))?;
+            let whole = MassProps::of(body(cut.body)?);
+            let distal = if spec.id == "key_flex" {
+                // The back arm: a share of the key's mass as a uniform bar from the cut
+                // to the back rail's pad.
+                let back = (params.key.back_pad_mm[0] - params.key.pivot_mm[0]) * 1e-3;
+                let length = back + 0.01 - cut.at[0];
+                let mass = KEY_BACK_MASS_SHARE * whole.mass;
+                MassProps {
+                    mass,
+                    com: [cut.at[0] + 0.5 * length, whole.com[1]],
+                    inertia: mass * length * length / 12.0,
+                }
+            } else {
+                MassProps {
+                    mass: HEAD_MASS_SHARE * whole.mass,
+                    com: HEAD_COM_M,
+                    inertia: HEAD_INERTIA_KG_M2,
+                }
+            };
+            let r2 = (distal.com[0] - cut.at[0]).powi(2) + (distal.com[1] - cut.at[1]).powi(2);
+            let inertia = distal.inertia + distal.mass * r2;
+            mechanism.split_body(
+                cut.body,
+                cut.at,
+                cut.along,
+                cut.new_body,
+                distal,
+                flex(c, zeta, inertia),
+            )?
+        }
+        "backcheck_compliance" => {
+            let c = value(spec, values, "compliance_rad_n_m")?;
+            let zeta = value(spec, values, "zeta")?;
+            if c <= 0.0 {
+                return Err(bad(spec.id, format!("compliance {c} must be positive")));
+            }
+            let k = &params.key;
+            let head = [
+                (k.backcheck_mm[0] - k.pivot_mm[0]) * 1e-3,
+                (k.backcheck_mm[1] - k.pivot_mm[1]) * 1e-3,
+            ];
+            let root = [head[0], BACKCHECK_WIRE_ROOT_Y_M];
+            let props = MassProps {
+                mass: BACKCHECK_MASS_KG,
+                com: head,
+                inertia: BACKCHECK_INERTIA_KG_M2,
+            };
+            let inertia = props.inertia
+                + props.mass * ((head[0] - root[0]).powi(2) + (head[1] - root[1]).powi(2));
+            mechanism.mount_compliant(
+                "backcheck",
+                Side::A,
+                "backcheck",
+                root,
+                props,
+                flex(c, zeta, inertia),
+            )?
+        }
+        "keybed_felt" | "felt_hysteresis" => {
+            let contact = if spec.id == "keybed_felt" {
+                "front_rail"
+            } else {
+                "jack_knuckle"
+            };
+            let pair = mechanism
+                .contacts
+                .iter()
+                .find(|c| c.name == contact)
+                .ok_or_else(|| bad(spec.id, format!("the action has no contact '{contact}'")))?;
+            let LawSpec::Felt { k, p, e, smoothing } = pair.law.clone() else {
+                return Err(bad(
+                    spec.id,
+                    format!("contact '{contact}' has no felt law to change"),
+                ));
+            };
+            let law = if spec.id == "keybed_felt" {
+                LawSpec::Felt {
+                    k: k * value(spec, values, "k_scale")?,
+                    p,
+                    e: value(spec, values, "e")?.clamp(0.02, 1.0),
+                    smoothing,
+                }
+            } else {
+                LawSpec::Felt {
+                    k,
+                    p,
+                    e: (e + value(spec, values, "de")?).clamp(0.02, 1.0),
+                    smoothing,
+                }
+            };
+            mechanism.swap_law(contact, law)?
+        }
+        "knuckle_friction" => {
+            let contact = "jack_knuckle";
+            let pair = mechanism
+                .contacts
+                .iter()
+                .find(|c| c.name == contact)
+                .ok_or_else(|| bad(spec.id, format!("the action has no contact '{contact}'")))?;
+            let dmu = value(spec, values, "dmu")?;
+            let friction = match pair.friction.clone() {
+                Some(ContactFrictionSpec::Coulomb { mu, regularization }) => {
+                    ContactFrictionSpec::Coulomb {
+                        mu: (mu + dmu).max(0.0),
+                        regularization,
+                    }
+                }
+                None => ContactFrictionSpec::Coulomb {
+                    mu: dmu.max(0.0),
+                    regularization: 1e-3,
+                },
+                Some(other) => {
+                    return Err(bad(
+                        spec.id,
+                        format!("contact '{contact}' has friction {other:?}, not a coefficient"),
+                    ));
+                }
+            };
+            mechanism.swap_friction(contact, Some(friction))?
+        }
+        other => return Err(bad(other, "not an effect of the action family".into())),
+    };
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ModelKind;
+
+    fn grand() -> (ActionParams, Mechanism) {
+        let params = ActionParams::reference();
+        let m = crate::describe::grand_mechanism(&params, ModelKind::Double, None).expect("grand");
+        (params, m)
+    }
+
+    /// Every effect adds itself at its typical strength to a mechanism that builds; the
+    /// splits add one body each and keep the total mass.
+    #[test]
+    fn every_effect_transforms_the_grand() {
+        let (params, m) = grand();
+        let mass = |m: &Mechanism| m.bodies.iter().map(|b| b.mass).sum::<f64>();
+        for spec in &ACTION_EFFECTS {
+            let values: Vec<f64> = spec.params.iter().map(|p| p.typical).collect();
+            let t = apply(&m, spec, &values, &params).expect(spec.id);
+            let added = t.bodies.len() - m.bodies.len();
+            let expected = usize::from(matches!(
+                spec.id,
+                "key_flex" | "shank_flex" | "backcheck_compliance"
+            ));
+            assert_eq!(added, expected, "{}", spec.id);
+            assert!((mass(&t) - mass(&m)).abs() < 1e-12, "{}", spec.id);
+            assert_ne!(t, m, "{} changed nothing", spec.id);
+            t.build_with(&crate::describe::PianoExtensions)
+                .expect(spec.id);
+            // At its null it changes nothing.
+            let mut null = values.clone();
+            null[0] = spec.params[0].null.expect("strength has a null");
+            assert_eq!(apply(&m, spec, &null, &params).expect(spec.id), m);
+        }
+    }
+
+    #[test]
+    fn markers_beyond_a_cut_ride_the_new_body() {
+        let (b, p) = marker_body(Some("shank_flex"), "hammer", [0.132, 0.0356]);
+        assert_eq!(b, "hammer_head");
+        assert!((p[0] - 0.022).abs() < 1e-12 && (p[1] - 0.0356).abs() < 1e-12);
+        assert_eq!(
+            marker_body(Some("shank_flex"), "hammer", [0.06, 0.01]).0,
+            "hammer"
+        );
+        assert_eq!(
+            marker_body(Some("key_flex"), "key", [0.22, 0.0]).0,
+            "key_back_arm"
+        );
+        assert_eq!(marker_body(Some("key_flex"), "key", [-0.2, 0.0]).0, "key");
+        assert_eq!(marker_body(None, "key", [0.22, 0.0]).0, "key");
+    }
+}
