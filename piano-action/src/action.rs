@@ -267,6 +267,36 @@ impl Action {
         Ok(q)
     }
 
+    /// The coordinates of `kind` with its description changed by `transform`, settled at
+    /// rest with nothing on the key, as [`Action::rest_coordinates`] (the last few
+    /// remembered, by parameters and changed description).
+    pub fn rest_coordinates_transformed(
+        params: &ActionParams,
+        kind: ModelKind,
+        transform: Transform<'_>,
+    ) -> Result<Vec<f64>> {
+        type Cache = Vec<(ModelKind, ActionParams, mbs_mechanism::Mechanism, Vec<f64>)>;
+        static CACHE: std::sync::Mutex<Cache> = std::sync::Mutex::new(Vec::new());
+        let mechanism = transform(&crate::describe::grand_mechanism(params, kind, None)?)?;
+        let lookup = |cache: &Cache| {
+            cache
+                .iter()
+                .find(|(k, p, m, _)| *k == kind && p == params && *m == mechanism)
+                .map(|(_, _, _, q)| q.clone())
+        };
+        if let Some(q) = CACHE.lock().ok().and_then(|c| lookup(&c)) {
+            return Ok(q);
+        }
+        let q = Self::from_mechanism(params, kind, None, &mechanism)?.settled_coordinates()?;
+        if let Ok(mut cache) = CACHE.lock() {
+            if cache.len() >= 8 {
+                cache.remove(0);
+            }
+            cache.push((kind, params.clone(), mechanism, q.clone()));
+        }
+        Ok(q)
+    }
+
     fn settle(params: &ActionParams, kind: ModelKind) -> Result<Vec<f64>> {
         Action::build(params, kind)?.settled_coordinates()
     }

@@ -1109,15 +1109,10 @@ fn synth(
     match experiment {
         "pendulum" => {}
         key_drive::EXPERIMENT => {
-            if effect.is_some() {
-                return Err(
-                    "option --effect: the key_drive experiment has no effect library yet \
-                     (key_flex, shank_flex, backcheck_compliance, keybed_felt, \
-                     felt_hysteresis and knuckle_friction come next); leave --effect out for \
-                     the baseline action"
-                        .into(),
-                );
-            }
+            let effect = effect
+                .map(piano_action::identify::action_effects::ActionEffect::parse)
+                .transpose()
+                .map_err(|e| e.to_string())?;
             let options = key_drive::KeyDriveOptions {
                 seed,
                 mass_kg: mass,
@@ -1126,6 +1121,7 @@ fn synth(
                     .map(|h| h * 1e-3)
                     .collect(),
                 duration_s: duration.unwrap_or(0.3),
+                effect,
                 ..Default::default()
             };
             commands::synth_key_drive_to_disk(params, &options, out, truth, force)

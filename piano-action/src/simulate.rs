@@ -446,9 +446,7 @@ pub fn prepare_transformed(
     // the layout put it relative to the key top).
     let rest = match transform {
         None => Action::rest_coordinates(params, kind)?,
-        Some(_) => {
-            Action::build_transformed(params, kind, None, transform)?.settled_coordinates()?
-        }
+        Some(f) => Action::rest_coordinates_transformed(params, kind, f)?,
     };
     let rest_depth_mm = key_depth_mm(params, rest[0]);
     let mut action = Action::build_transformed(params, kind, presser, transform)?;

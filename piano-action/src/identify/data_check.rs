@@ -24,7 +24,8 @@ pub(super) struct Obs {
 pub(super) struct Run {
     pub(super) id: String,
     pub(super) role: Role,
-    pub(super) release_rad: f64,
+    /// The release: the angle (rad) of a swing, the height (m) of a key drive.
+    pub(super) release: f64,
     pub(super) times: Vec<f64>,
     pub(super) obs: Vec<Obs>,
     pub(super) lost_frames: usize,
@@ -258,45 +259,15 @@ pub(super) fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
         }
         let data = dataset.read_run(spec).map_err(data_err)?;
         let release = check_run(dataset, spec, i, &data, declared.to_radians())?;
-        let channels: Vec<Vec<Option<f64>>> = data
-            .positions
-            .iter()
-            .flat_map(|track| (0..2).map(move |a| track.iter().map(|p| p.map(|p| p[a])).collect()))
-            .collect();
-        let refs: Vec<&[Option<f64>]> = channels.iter().map(Vec::as_slice).collect();
-        let outliers = noise::detect_outliers(&data.time_s, &refs, &OutlierOptions::default());
-        let mut obs = Vec::new();
-        for (m, track) in data.positions.iter().enumerate() {
-            for axis in 0..2 {
-                let mut prev_ok = false;
-                for (k, p) in track.iter().enumerate() {
-                    match p {
-                        Some(p) if !outliers[k] => {
-                            obs.push(Obs {
-                                frame: k,
-                                marker: m,
-                                axis,
-                                value: p[axis],
-                                segment_start: !prev_ok,
-                            });
-                            prev_ok = true;
-                        }
-                        _ => prev_ok = false,
-                    }
-                }
-            }
-        }
-        let lost = (0..data.time_s.len())
-            .filter(|&k| data.positions.iter().any(|t| t[k].is_none()))
-            .count();
+        let (obs, outliers, lost) = observations(&data);
         runs.push(Run {
             id: spec.id.clone(),
             role: spec.role,
-            release_rad: release,
+            release,
             times: data.time_s,
             obs,
             lost_frames: lost,
-            outlier_frames: (0..outliers.len()).filter(|&k| outliers[k]).collect(),
+            outlier_frames: outliers,
         });
     }
     if !runs.iter().any(|r| r.role == Role::Fit) {
@@ -305,22 +276,68 @@ pub(super) fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
             message: "field `runs`: no run has role \"fit\"".into(),
         });
     }
-    // The noise floor from the frames themselves, outliers left out: every run's
-    // coordinates as channels over a common frame index (shorter runs padded as lost).
+    let noise = noise_floor(&file, &runs, dataset.markers.len())?;
+    Ok((runs, noise))
+}
+
+/// A run's observations (every seen coordinate of every marker, in marker, axis, frame
+/// order), the frames flagged as gross errors (left out) and the number of frames with a
+/// marker lost.
+pub(super) fn observations(data: &mbs_identify::RunData) -> (Vec<Obs>, Vec<usize>, usize) {
+    let channels: Vec<Vec<Option<f64>>> = data
+        .positions
+        .iter()
+        .flat_map(|track| (0..2).map(move |a| track.iter().map(|p| p.map(|p| p[a])).collect()))
+        .collect();
+    let refs: Vec<&[Option<f64>]> = channels.iter().map(Vec::as_slice).collect();
+    let outliers = noise::detect_outliers(&data.time_s, &refs, &OutlierOptions::default());
+    let mut obs = Vec::new();
+    for (m, track) in data.positions.iter().enumerate() {
+        for axis in 0..2 {
+            let mut prev_ok = false;
+            for (k, p) in track.iter().enumerate() {
+                match p {
+                    Some(p) if !outliers[k] => {
+                        obs.push(Obs {
+                            frame: k,
+                            marker: m,
+                            axis,
+                            value: p[axis],
+                            segment_start: !prev_ok,
+                        });
+                        prev_ok = true;
+                    }
+                    _ => prev_ok = false,
+                }
+            }
+        }
+    }
+    let lost = (0..data.time_s.len())
+        .filter(|&k| data.positions.iter().any(|t| t[k].is_none()))
+        .count();
+    (
+        obs,
+        (0..outliers.len()).filter(|&k| outliers[k]).collect(),
+        lost,
+    )
+}
+
+/// The noise floor and its AR(1) correlation from the frames themselves, outliers left
+/// out: every run's coordinates as channels over a common frame index (shorter runs padded
+/// as lost). `file` is the dataset's, for the error.
+pub(super) fn noise_floor(file: &std::path::Path, runs: &[Run], markers: usize) -> Result<Ar1> {
     let width = runs.iter().map(|r| r.times.len()).max().unwrap_or(0);
     let mut channels: Vec<Vec<Option<f64>>> = Vec::new();
-    for r in &runs {
+    for r in runs {
         let first = channels.len();
-        channels.extend((0..2 * dataset.markers.len()).map(|_| vec![None; width]));
+        channels.extend((0..2 * markers).map(|_| vec![None; width]));
         for o in &r.obs {
             channels[first + 2 * o.marker + o.axis][o.frame] = Some(o.value);
         }
     }
     let refs: Vec<&[Option<f64>]> = channels.iter().map(Vec::as_slice).collect();
-    let noise =
-        noise::estimate_ar1(&refs, &vec![false; width]).ok_or_else(|| PianoError::File {
-            path: file,
-            message: "too few frames to estimate the tracking noise".into(),
-        })?;
-    Ok((runs, noise))
+    noise::estimate_ar1(&refs, &vec![false; width]).ok_or_else(|| PianoError::File {
+        path: file.to_path_buf(),
+        message: "too few frames to estimate the tracking noise".into(),
+    })
 }

@@ -353,8 +353,8 @@ impl Problem<'_> {
             p.push(FreeParam::linear(
                 format!("{}.release_angle_deg", r.id),
                 *release,
-                r.release_rad - 1f64.to_radians(),
-                r.release_rad + 1f64.to_radians(),
+                r.release - 1f64.to_radians(),
+                r.release + 1f64.to_radians(),
                 1e-3,
             ));
             p.push(FreeParam::linear(
@@ -438,9 +438,9 @@ impl Problem<'_> {
         let free = [
             FreeParam::linear(
                 "release_rad",
-                r.release_rad,
-                r.release_rad - 1f64.to_radians(),
-                r.release_rad + 1f64.to_radians(),
+                r.release,
+                r.release - 1f64.to_radians(),
+                r.release + 1f64.to_radians(),
                 1e-3,
             ),
             FreeParam::linear("offset_s", 0.0, -1.5 * frame, 1.5 * frame, 0.1 * frame),
@@ -589,7 +589,7 @@ pub fn diagnose(
             inertia_com_kg_m2: h.inertia_com_kg_m2,
             coulomb_n_m: h.pivot_friction_n_m * scale,
             effect: None,
-            runs: problem.fit_runs().map(|r| (r.release_rad, 0.0)).collect(),
+            runs: problem.fit_runs().map(|r| (r.release, 0.0)).collect(),
         };
         let f = problem.fit(&start)?;
         if baseline.as_ref().is_none_or(|b| f.fit.rss < b.fit.rss) {
@@ -624,7 +624,7 @@ pub fn diagnose(
         let (release, _) = problem
             .fit_runs()
             .position(|f| f.id == r.id)
-            .map_or((r.release_rad, 0.0), |j| baseline.setting.runs[j]);
+            .map_or((r.release, 0.0), |j| baseline.setting.runs[j]);
         let end = r.times.last().copied().unwrap_or(0.0) + 1.0 / dataset.fps;
         for (name, t0, t1) in swing_phases(&base_model, release, end) {
             windows.push(PhaseWindow {

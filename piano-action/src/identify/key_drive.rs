@@ -16,12 +16,14 @@ use std::collections::BTreeMap;
 use mbs_identify::{Camera, Dataset, MarkerSpec, Rng, Role, RunData, RunSpec, SCHEMA_VERSION};
 use serde::Serialize;
 
+use super::action_effects::{ActionEffect, marker_body};
 use super::synth::{CameraSynth, check_camera, tracked};
 use crate::ModelKind;
+use crate::action::Transform;
 use crate::error::{PianoError, Result};
 use crate::key::KeyGeometry;
 use crate::params::ActionParams;
-use crate::simulate::{Input, prepare, simulate};
+use crate::simulate::{Input, prepare_transformed, simulate_transformed};
 
 /// The experiment's name in `dataset.json`.
 pub const EXPERIMENT: &str = "key_drive";
@@ -71,6 +73,8 @@ pub struct KeyDriveOptions {
     /// Whether the action differs from the parameter file by the nuisance mismatches (off:
     /// the file's action exactly, to check the pipeline).
     pub nuisance: bool,
+    /// The hidden effect, if any.
+    pub effect: Option<ActionEffect>,
 }
 
 impl Default for KeyDriveOptions {
@@ -83,6 +87,7 @@ impl Default for KeyDriveOptions {
             duration_s: 0.3,
             camera: CameraSynth::default(),
             nuisance: true,
+            effect: None,
         }
     }
 }
@@ -94,6 +99,10 @@ pub struct KeyDriveTruth {
     pub experiment: String,
     /// The seed.
     pub seed: u64,
+    /// The hidden effect's id (`None`: none).
+    pub effect: Option<String>,
+    /// Its parameters.
+    pub effect_params: BTreeMap<String, f64>,
     /// Each mismatched parameter (its path) and the factor it was multiplied by.
     pub nuisance: BTreeMap<String, f64>,
     /// Tracking noise SD (m).
@@ -192,27 +201,51 @@ fn marker_tracks(
     input: &Input,
     duration_s: f64,
     markers: &[MarkerSpec],
+    effect: Option<&ActionEffect>,
 ) -> Result<(Vec<f64>, CleanTracks)> {
-    let run = simulate(params, kind, input, duration_s, 2e-5)?;
-    marker_tracks_of(params, kind, input, &run, markers)
+    let run = simulate_effect(params, kind, input, duration_s, effect)?;
+    marker_tracks_of(params, kind, input, &run, markers, effect)
+}
+
+/// Simulates the action of `params` with `effect` added, output every 20 µs.
+pub(super) fn simulate_effect(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    duration_s: f64,
+    effect: Option<&ActionEffect>,
+) -> Result<crate::simulate::Run> {
+    match effect {
+        None => simulate_transformed(params, kind, input, duration_s, 2e-5, None, &mut |_| {}),
+        Some(e) => {
+            let f = |m: &mbs_mechanism::Mechanism| e.apply(m, params);
+            simulate_transformed(params, kind, input, duration_s, 2e-5, Some(&f), &mut |_| {})
+        }
+    }
 }
 
 /// The world positions (m) of `markers` along `run` (simulated from `input`).
-fn marker_tracks_of(
+pub(super) fn marker_tracks_of(
     params: &ActionParams,
     kind: ModelKind,
     input: &Input,
     run: &crate::simulate::Run,
     markers: &[MarkerSpec],
+    effect: Option<&ActionEffect>,
 ) -> Result<(Vec<f64>, CleanTracks)> {
-    let prepared = prepare(params, kind, input)?;
+    let f = |m: &mbs_mechanism::Mechanism| match effect {
+        Some(e) => e.apply(m, params),
+        None => Ok(m.clone()),
+    };
+    let prepared = prepare_transformed(params, kind, input, effect.map(|_| &f as Transform))?;
     let system = &prepared.action.system;
     let model = system.model();
     let points: Vec<_> = markers
         .iter()
         .map(|m| {
-            let frame = model.frame_id(&m.body)?;
-            Ok(mbs_core::frame_point(model, frame, m.local_m))
+            let (body, local) = marker_body(effect.map(|e| e.spec.id), &m.body, m.local_m);
+            let frame = model.frame_id(&body)?;
+            Ok(mbs_core::frame_point(model, frame, local))
         })
         .collect::<Result<_>>()?;
     let sol = &run.solution;
@@ -229,7 +262,7 @@ fn marker_tracks_of(
 
 /// The position at `t` of a track sampled at `times` (linear; held before the first and
 /// after the last sample).
-fn at(times: &[f64], track: &[[f64; 2]], t: f64) -> [f64; 2] {
+pub(super) fn at(times: &[f64], track: &[[f64; 2]], t: f64) -> [f64; 2] {
     let i = times.partition_point(|&s| s <= t);
     if i == 0 {
         return track[0];
@@ -277,6 +310,7 @@ pub fn synthesize(
             &input,
             options.duration_s + 1e-3,
             &markers,
+            options.effect.as_ref(),
         )?;
         let clean: CleanTracks = tracks
             .iter()
@@ -333,6 +367,12 @@ pub fn synthesize(
     let truth = KeyDriveTruth {
         experiment: EXPERIMENT.into(),
         seed: options.seed,
+        effect: options.effect.as_ref().map(|e| e.spec.id.to_string()),
+        effect_params: options
+            .effect
+            .as_ref()
+            .map(ActionEffect::params)
+            .unwrap_or_default(),
         nuisance,
         sigma_m: options.camera.sigma_m,
         runs: truth_runs,
@@ -593,38 +633,8 @@ pub fn replay(
     }
     let duration = run.time_s[run.time_s.len() - 1] - run.time_s[0];
     let input = Input::Motion { points };
-    let sim = simulate(params, kind, &input, duration, 2e-5)?;
-    // The escape: the jack leaving the knuckle after the let-off (the knuckle contact's
-    // gap rising through zero).
-    let knuckle = prepare(params, kind, &input)?
-        .action
-        .contacts
-        .get("jack_knuckle")
-        .copied();
-    let first = |name: &str, after: f64| {
-        sim.events
-            .iter()
-            .find(|e| e.name == name && e.time_s >= after)
-            .map(|e| e.time_s)
-    };
-    let let_off = first("let_off", 0.0);
-    let escape = let_off.and_then(|l| {
-        sim.solution
-            .events
-            .iter()
-            .find(|e| {
-                e.time >= l
-                    && e.direction == mbs_integrators::Crossing::Rising
-                    && e.source.map(|s| s.element) == knuckle
-            })
-            .map(|e| e.time)
-    });
-    let strike = first("string_contact_start", 0.0)
-        .and_then(|s| first("string_contact_end", s).map(|e| (s, e)));
-    let check = strike
-        .and_then(|(_, e)| first("check_catch", e))
-        .map(|c| (c, first("check_release", c)));
-    let (sim_t, tracks) = marker_tracks_of(params, kind, &input, &sim, &dataset.markers)?;
+    let sim = simulate_effect(params, kind, &input, duration, None)?;
+    let (sim_t, tracks) = marker_tracks_of(params, kind, &input, &sim, &dataset.markers, None)?;
     let camera = Camera {
         exposure_s: dataset.exposure_s,
         offset_s: 0.0,
@@ -663,8 +673,57 @@ pub fn replay(
             .iter()
             .map(|e| (e.name.to_string(), e.time_s))
             .collect(),
-        phases: phases(let_off, escape, strike, check, duration),
+        phases: sequence(params, kind, &input, &sim, duration, None)?,
     })
+}
+
+/// The phases of the functional sequence in a simulated run `sim` (of the action of
+/// `params` with `effect`, driven by `input`) up to `end`: the let-off (the jack's toe on
+/// its button), the escape (the jack leaving the knuckle after it), the string contact,
+/// the check and its release.
+pub(super) fn sequence(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    sim: &crate::simulate::Run,
+    end: f64,
+    effect: Option<&ActionEffect>,
+) -> Result<Vec<Phase>> {
+    // The escape: the jack leaving the knuckle after the let-off (the knuckle contact's
+    // gap rising through zero).
+    let f = |m: &mbs_mechanism::Mechanism| match effect {
+        Some(e) => e.apply(m, params),
+        None => Ok(m.clone()),
+    };
+    let knuckle = prepare_transformed(params, kind, input, effect.map(|_| &f as Transform))?
+        .action
+        .contacts
+        .get("jack_knuckle")
+        .copied();
+    let first = |name: &str, after: f64| {
+        sim.events
+            .iter()
+            .find(|e| e.name == name && e.time_s >= after)
+            .map(|e| e.time_s)
+    };
+    let let_off = first("let_off", 0.0);
+    let escape = let_off.and_then(|l| {
+        sim.solution
+            .events
+            .iter()
+            .find(|e| {
+                e.time >= l
+                    && e.direction == mbs_integrators::Crossing::Rising
+                    && e.source.map(|s| s.element) == knuckle
+            })
+            .map(|e| e.time)
+    });
+    let strike = first("string_contact_start", 0.0)
+        .and_then(|s| first("string_contact_end", s).map(|e| (s, e)));
+    let check = strike
+        .and_then(|(_, e)| first("check_catch", e))
+        .map(|c| (c, first("check_release", c)));
+    Ok(phases(let_off, escape, strike, check, end))
 }
 
 #[cfg(test)]
@@ -722,5 +781,92 @@ mod tests {
             .map(|(&t, v)| (v.expect("every frame") - truth(t)).abs())
             .fold(0.0, f64::max);
         assert!(worst < 1e-5, "worst error {worst:e} (gross error 1e-3)");
+    }
+}
+
+#[cfg(test)]
+mod probe {
+    use super::*;
+    use crate::identify::action_effects::ACTION_EFFECTS;
+
+    /// How much each effect at its typical strength moves each marker, by phase of the
+    /// baseline (a probe for choosing strengths; prints).
+    #[test]
+    #[ignore]
+    fn effect_visibility() {
+        let params = ActionParams::reference();
+        let markers = default_markers(&params, 3e-5);
+        let input = Input::MassDrop {
+            mass_kg: 1.0,
+            height_m: 0.0,
+        };
+        let t0 = std::time::Instant::now();
+        let base = simulate_effect(&params, ModelKind::Double, &input, 0.3, None).unwrap();
+        eprintln!("one sim {:?}", t0.elapsed());
+        let (bt, btr) =
+            marker_tracks_of(&params, ModelKind::Double, &input, &base, &markers, None).unwrap();
+        let ev: Vec<(String, f64)> = base
+            .events
+            .iter()
+            .map(|e| (e.name.to_string(), e.time_s))
+            .collect();
+        eprintln!("events {ev:?}");
+        let report = |name: &str, et: &[f64], etr: &CleanTracks| {
+            let mut line = format!("{name:50}");
+            for (m, mk) in markers.iter().enumerate() {
+                let mut win = [0.0f64; 6];
+                let mut cnt = [0usize; 6];
+                for k in 0..900 {
+                    let t = k as f64 / 3000.0;
+                    let a = at(&bt, &btr[m], t);
+                    let b = at(et, &etr[m], t);
+                    let d = (a[0] - b[0]).hypot(a[1] - b[1]);
+                    let w = (t / 0.05) as usize;
+                    win[w.min(5)] += d * d;
+                    cnt[w.min(5)] += 1;
+                }
+                line += &format!(" {}:", mk.name);
+                for w in 0..6 {
+                    line += &format!(" {:.0}", 1e6 * (win[w] / cnt[w] as f64).sqrt());
+                }
+            }
+            eprintln!("{line}");
+        };
+        for seed in 1..6 {
+            let mut rng = Rng::new(seed);
+            let (p2, _) = mismatched(&params, &mut rng).unwrap();
+            let (et, etr) =
+                marker_tracks(&p2, ModelKind::Double, &input, 0.3, &markers, None).unwrap();
+            report(&format!("nuisance seed {seed}"), &et, &etr);
+        }
+        let arg = std::env::var("EFFECTS").unwrap_or_default();
+        for spec in &ACTION_EFFECTS {
+            let text = arg
+                .split(';')
+                .find(|s| s.starts_with(spec.id))
+                .unwrap_or(spec.id);
+            let e = ActionEffect::parse(text).unwrap();
+            let (et, etr) =
+                marker_tracks(&params, ModelKind::Double, &input, 0.3, &markers, Some(&e)).unwrap();
+            let mut line = format!("{text:50}");
+            for (m, mk) in markers.iter().enumerate() {
+                let mut win = [0.0f64; 6];
+                let mut cnt = [0usize; 6];
+                for k in 0..900 {
+                    let t = k as f64 / 3000.0;
+                    let a = at(&bt, &btr[m], t);
+                    let b = at(&et, &etr[m], t);
+                    let d = (a[0] - b[0]).hypot(a[1] - b[1]);
+                    let w = (t / 0.05) as usize;
+                    win[w.min(5)] += d * d;
+                    cnt[w.min(5)] += 1;
+                }
+                line += &format!(" {}:", mk.name);
+                for w in 0..6 {
+                    line += &format!(" {:.0}", 1e6 * (win[w] / cnt[w] as f64).sqrt());
+                }
+            }
+            eprintln!("{line}");
+        }
     }
 }

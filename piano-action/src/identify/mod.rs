@@ -8,6 +8,7 @@ pub mod commands;
 mod data_check;
 pub mod diagnose;
 pub mod effects;
+pub mod key_diagnose;
 pub mod key_drive;
 pub mod report;
 pub mod swing_model;

@@ -344,17 +344,22 @@ pub fn synthesize(
     Ok((dataset, runs, truth))
 }
 
-/// Parses `--effect ID[:name=value,...]`; parameters not given take the effect's typical
-/// (clearly visible) value.
-pub fn parse_effect(text: &str) -> Result<EffectEntry> {
+/// Parses `--effect ID[:name=value,...]` against a library (`lookup` finds an id, `known`
+/// lists them for messages): the spec and every parameter's value, those not given at the
+/// effect's typical (clearly visible) value.
+pub fn parse_effect_in(
+    text: &str,
+    lookup: fn(&str) -> Option<&'static mbs_identify::EffectSpec>,
+    known: &str,
+) -> Result<(
+    &'static mbs_identify::EffectSpec,
+    std::collections::BTreeMap<String, f64>,
+)> {
     let (id, rest) = text.split_once(':').unwrap_or((text, ""));
-    let spec = super::effects::effect_spec(id.trim()).ok_or_else(|| {
+    let spec = lookup(id.trim()).ok_or_else(|| {
         PianoError::option(
             "--effect",
-            format!(
-                "no effect '{id}' in the library (known: {})",
-                super::effects::library_ids()
-            ),
+            format!("no effect '{id}' in the library (known: {known})"),
         )
     })?;
     let mut params: std::collections::BTreeMap<String, f64> = spec
@@ -386,6 +391,17 @@ pub fn parse_effect(text: &str) -> Result<EffectEntry> {
         }
         params.insert(name.trim().to_string(), v);
     }
+    Ok((spec, params))
+}
+
+/// Parses `--effect ID[:name=value,...]`; parameters not given take the effect's typical
+/// (clearly visible) value.
+pub fn parse_effect(text: &str) -> Result<EffectEntry> {
+    let (spec, params) = parse_effect_in(
+        text,
+        super::effects::effect_spec,
+        &super::effects::library_ids(),
+    )?;
     let entry = EffectEntry {
         id: spec.id.to_string(),
         location: super::effects::HAMMER_FLANGE.to_string(),
