@@ -148,8 +148,21 @@ enum Command {
     },
     /// Find where measured motion and the model disagree, name the missing effect, add it
     /// and show the gap shrink. Reads a tracked-marker dataset (DIR/dataset.json and one
-    /// CSV per run, schema 1; the `pendulum` swing test for now) and writes
-    /// OUT/report.json, report.md and report.html.
+    /// CSV per run, schema 1) and writes OUT/report.json, report.md and report.html.
+    ///
+    /// Experiment `pendulum`: the hammer swing test (markers on the hammer, origin at its
+    /// flange pin; runs carry `conditions.release_angle_deg`); effects pivot_viscous,
+    /// air_drag, pivot_stribeck, pivot_load_friction.
+    ///
+    /// Experiment `key_drive`: a mass released on the key, markers on any body of the
+    /// action (key, wippen, jack, repetition_lever, hammer, backcheck) in the parameter
+    /// file's body frames and world frame, in metres; `"drive": "key_front"` names the
+    /// marker that drives the key; runs carry `conditions.mass_kg` (required: the model's
+    /// key carries it) and `conditions.release_height_m`. The drive marker is fitted, not
+    /// prescribed: the key moves under the mass as a key can, the release height and the
+    /// clock fitted per run. Effects key_flex, shank_flex, backcheck_compliance,
+    /// keybed_felt, felt_hysteresis, knuckle_friction; confusable effects the markers
+    /// cannot separate are reported as ambiguous, with the marker that would.
     Diagnose {
         /// The dataset's folder.
         dataset: std::path::PathBuf,
@@ -1026,6 +1039,12 @@ fn diagnose(
     force: bool,
 ) -> Result<(), String> {
     use piano_action::identify::{commands, diagnose::DiagnoseOptions};
+    let experiment = mbs_identify::Dataset::load(dataset)
+        .map(|d| d.experiment)
+        .unwrap_or_default();
+    if experiment == piano_action::identify::key_drive::EXPERIMENT {
+        return diagnose_key_drive(params, dataset, out, write_params, library, force);
+    }
     let source = match params_file {
         Some(p) => std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?,
         None => piano_action::params::DEFAULT_PARAMS_TOML.to_string(),
@@ -1079,6 +1098,92 @@ fn diagnose(
     }
     if let Some(why) = &outcome.params_refused {
         eprintln!("note: {why}");
+    }
+    Ok(())
+}
+
+/// `piano diagnose` on a key-drive dataset.
+fn diagnose_key_drive(
+    params: &piano_action::params::ActionParams,
+    dataset: &std::path::Path,
+    out: &std::path::Path,
+    write_params: Option<&std::path::Path>,
+    library: Option<&str>,
+    force: bool,
+) -> Result<(), String> {
+    use piano_action::identify::{commands, key_diagnose::KeyDiagnoseOptions, key_report};
+    if write_params.is_some() {
+        return Err(
+            "option --write-params: a key-drive diagnosis names effects that change the \
+             action's mechanism (a split key, a sprung back-check), which a parameter file \
+             cannot hold; read the calibrated values and the effect in report.json"
+                .into(),
+        );
+    }
+    let options = KeyDiagnoseOptions {
+        library: commands::action_library(library).map_err(|e| e.to_string())?,
+        ..KeyDiagnoseOptions::default()
+    };
+    let bar = indicatif::ProgressBar::new(100);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:30} {msg} ({elapsed})") {
+        bar.set_style(style);
+    }
+    let progress = |msg: &str, fraction: f64| {
+        bar.set_message(msg.to_string());
+        bar.set_position((fraction * 100.0) as u64);
+    };
+    let result =
+        commands::diagnose_key_drive_to_disk(params, dataset, &options, out, force, &progress);
+    bar.finish_and_clear();
+    let (d, written) = result.map_err(|e| e.to_string())?;
+    println!("decision: {}. {}", d.decision, d.summary);
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.1}", v * 1e6));
+    println!(
+        "gap (RMS per coordinate): fitted {:.1} -> {:.1} um, held-out {} -> {} um, noise floor {:.1} um",
+        d.before_rms_m * 1e6,
+        d.after_rms_m * 1e6,
+        opt(d.heldout_before_rms_m),
+        opt(d.heldout_after_rms_m),
+        d.noise_floor_m * 1e6
+    );
+    if let Some((b, a)) = key_report::post_check_gap(&d) {
+        println!(
+            "post-check gap: {:.1} -> {:.1} um ({:.1}x)",
+            b * 1e6,
+            a * 1e6,
+            b / a.max(1e-300)
+        );
+    }
+    println!(
+        "flagged: {} phase, worst on {}{}",
+        d.flagged_phase,
+        d.flagged_marker,
+        d.onset.as_ref().map_or(String::new(), |o| format!(
+            "; onset {:.1} ms ({}{})",
+            o.time_s * 1e3,
+            o.marker,
+            o.after_event
+                .as_ref()
+                .map_or(String::new(), |(e, dt)| format!(
+                    ", {:.1} ms after {e}",
+                    dt * 1e3
+                ))
+        ))
+    );
+    for c in &d.candidates {
+        println!("  {:<22} dBIC {:>9.1}  {}", c.id, c.delta_bic, c.why);
+    }
+    let total: f64 = d.timing.iter().map(|(_, t)| t).sum();
+    println!(
+        "time: {total:.1} s ({})",
+        d.timing
+            .iter()
+            .map(|(s, t)| format!("{s} {t:.1} s"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    for p in written {
+        println!("wrote {}", p.display());
     }
     Ok(())
 }

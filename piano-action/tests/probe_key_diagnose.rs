@@ -57,7 +57,7 @@ fn probe_key_drive_diagnosis() {
         "flagged {} / {}; onset {:?}",
         d.flagged_phase, d.flagged_marker, d.onset
     );
-    eprintln!("calibrated {:?}", d.calibrated);
+    eprintln!("calibrated {:?}\nrise {:?}", d.calibrated, d.rise_calibrated);
     for c in &d.candidates {
         eprintln!(
             "  {:22} dBIC {:9.1} fit {:7.1} flagged {:7.1} {:?} {}",

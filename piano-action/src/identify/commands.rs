@@ -150,6 +150,58 @@ pub fn library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::EffectSpe
     Ok(out)
 }
 
+/// The action family restricted to `ids` (comma-separated; all when `None`), for a
+/// key-drive diagnosis.
+pub fn action_library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::EffectSpec>> {
+    use super::action_effects::{ACTION_EFFECTS, action_effect_spec, action_library_ids};
+    let Some(ids) = ids else {
+        return Ok(ACTION_EFFECTS.iter().collect());
+    };
+    let mut out: Vec<&'static mbs_identify::EffectSpec> = Vec::new();
+    for id in ids.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let spec = action_effect_spec(id).ok_or_else(|| {
+            PianoError::option(
+                "--library",
+                format!(
+                    "no effect '{id}' in the key-drive library (known: {})",
+                    action_library_ids()
+                ),
+            )
+        })?;
+        if out.iter().any(|s| s.id == spec.id) {
+            return Err(PianoError::option(
+                "--library",
+                format!("'{id}' is listed twice"),
+            ));
+        }
+        out.push(spec);
+    }
+    if out.is_empty() {
+        return Err(PianoError::option(
+            "--library",
+            format!("names no effect (known: {})", action_library_ids()),
+        ));
+    }
+    Ok(out)
+}
+
+/// Reads the key-drive dataset in `dir`, diagnoses it and writes the report into `out`
+/// (see [`super::key_diagnose`]); returns the diagnosis and the files written.
+pub fn diagnose_key_drive_to_disk(
+    params: &ActionParams,
+    dir: &Path,
+    options: &super::key_diagnose::KeyDiagnoseOptions,
+    out: &Path,
+    force: bool,
+    progress: Progress<'_>,
+) -> Result<(super::key_diagnose::KeyDriveDiagnosis, Vec<PathBuf>)> {
+    super::report::check_out_dir(out, force)?;
+    let dataset = Dataset::load(dir).map_err(super::diagnose::dataset_error)?;
+    let d = super::key_diagnose::diagnose_key_drive(params, &dataset, options, progress)?;
+    let written = super::key_report::write_key_pages(&d, dir, out, force)?;
+    Ok((d, written))
+}
+
 /// What `piano diagnose` did.
 #[derive(Clone, Debug)]
 pub struct Outcome {

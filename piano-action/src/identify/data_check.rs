@@ -226,8 +226,8 @@ pub(super) fn prepare(dataset: &Dataset) -> Result<(Vec<Run>, Ar1)> {
                 "field `experiment`: '{}': `piano diagnose` knows the 'pendulum' experiment{}",
                 dataset.experiment,
                 if dataset.experiment == super::key_drive::EXPERIMENT {
-                    " (`piano synth` writes key-drive datasets; their diagnosis is not built \
-                     yet)"
+                    " (a key-drive dataset is diagnosed by `identify::key_diagnose`, which \
+                     `piano diagnose` picks from the experiment)"
                 } else {
                     ""
                 }

@@ -58,6 +58,10 @@ pub const CALIBRATED: [(&str, f64); 4] = [
     ("hammer.mass_g", 1.1),
 ];
 
+/// The index in [`CALIBRATED`] of the value the rise cannot see (the back-check's
+/// friction), held at the file's in the rise's calibration.
+const RISE_HELD: usize = 1;
+
 /// How far a run's release height may be fitted from the one its conditions state (m)
 /// [D]: a mass held over a key by hand is placed to a couple of millimetres.
 pub const HEIGHT_TOLERANCE_M: f64 = 2e-3;
@@ -73,6 +77,10 @@ pub const FIT_ATOL: f64 = 1e-8;
 /// Finite-difference step of the fits, in each parameter's typical unit [D]: 1 % (the
 /// simulation is event-driven, and smaller steps see its tolerance).
 pub const FD_STEP: f64 = 1e-2;
+
+/// The most accepted steps of a fit [D]: the fits start near their optimum (the rise's
+/// calibration, the screening's best point) and each step costs a Jacobian.
+pub const MAX_ITERATIONS: usize = 15;
 
 /// Options of a key-drive diagnosis.
 #[derive(Clone, Debug)]
@@ -199,6 +207,9 @@ pub struct KeyDriveDiagnosis {
     pub candidates: Vec<KeyCandidate>,
     /// The calibrated values (with the effect's when one is added).
     pub calibrated: BTreeMap<String, f64>,
+    /// The values calibrated on the rise alone (the frames before the string), the trusted
+    /// phase.
+    pub rise_calibrated: BTreeMap<String, f64>,
     /// Calibrated values at the edge of their search range.
     pub at_bound: Vec<String>,
     /// What the baseline calibration frees.
@@ -230,6 +241,10 @@ pub struct KeyDriveDiagnosis {
     /// Traces for the plots.
     #[serde(skip)]
     pub traces: Vec<MarkerTrace>,
+    /// The replay for the report (the action's drawing, the models' motions and the
+    /// markers, see `key_replay.js`).
+    #[serde(skip)]
+    pub replay: Option<serde_json::Value>,
 }
 
 /// Reads a key-drive dataset's runs, its mass and release heights, and the noise floor.
@@ -349,6 +364,9 @@ struct Problem<'a> {
 
 /// A simulated run: predicted observations, the model's events and its phases.
 struct Simulated {
+    /// The release height (m) and clock offset (s) it was run with.
+    height: f64,
+    offset: f64,
     predicted: Vec<f64>,
     /// Per marker, per frame (m).
     frames: Vec<Vec<[f64; 2]>>,
@@ -434,6 +452,8 @@ impl Problem<'_> {
             .collect();
         let phases = sequence(&p, self.kind, &input, &sim, last, s.effect.as_ref())?;
         Ok(Simulated {
+            height,
+            offset,
             predicted,
             frames,
             events: sim
@@ -469,20 +489,24 @@ impl Problem<'_> {
         LmOptions {
             threads: self.threads,
             cost_tolerance: 1e-6,
-            max_iterations: 25,
+            max_iterations: MAX_ITERATIONS,
             fd_relative_step: FD_STEP,
             ..LmOptions::default()
         }
     }
 
     /// Free parameters laid out: calibration, effect, per fitted run (height, offset).
-    fn free_params(&self, start: &Setting) -> Result<Vec<FreeParam>> {
+    /// On the rise (`rise`) the back-check's friction is held: nothing before the strike
+    /// touches the back-check.
+    fn free_params(&self, start: &Setting, rise: bool) -> Result<Vec<FreeParam>> {
         let file = self.file_cal()?;
         let mut p: Vec<FreeParam> = CALIBRATED
             .iter()
             .zip(file)
             .zip(start.cal)
-            .map(|(((name, spread), f), v)| {
+            .enumerate()
+            .filter(|(j, _)| !(rise && *j == RISE_HELD))
+            .map(|(_, (((name, spread), f), v))| {
                 FreeParam::log(
                     *name,
                     v.clamp(f / spread, f * spread),
@@ -525,10 +549,15 @@ impl Problem<'_> {
         Ok(p)
     }
 
-    fn setting_of(&self, template: &Setting, x: &[f64]) -> Setting {
+    fn setting_of(&self, template: &Setting, x: &[f64], rise: bool) -> Setting {
         let mut s = template.clone();
-        s.cal.copy_from_slice(&x[..4]);
-        let mut i = 4;
+        let mut i = 0;
+        for (j, c) in s.cal.iter_mut().enumerate() {
+            if !(rise && j == RISE_HELD) {
+                *c = x[i];
+                i += 1;
+            }
+        }
         if let Some(e) = &mut s.effect {
             for v in e.values.iter_mut() {
                 *v = x[i];
@@ -544,9 +573,10 @@ impl Problem<'_> {
 
     /// Output-error fit from `start` on the fitted runs' frames before `horizon` (s).
     fn fit(&self, start: &Setting, horizon: f64) -> Result<Fitted> {
-        let free = self.free_params(start)?;
+        let rise = horizon.is_finite();
+        let free = self.free_params(start, rise)?;
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
-            let s = self.setting_of(start, x);
+            let s = self.setting_of(start, x, rise);
             let mut out = Vec::new();
             for (r, (h, off)) in self.fit_runs().zip(&s.runs) {
                 let sim = self.simulate(&s, r, *h, *off).map_err(|e| e.to_string())?;
@@ -560,7 +590,7 @@ impl Problem<'_> {
         let k = free.len() as f64;
         let bic = n * (fit.rss / n).ln() + k * n.ln();
         Ok(Fitted {
-            setting: self.setting_of(start, &fit.values),
+            setting: self.setting_of(start, &fit.values, rise),
             fit,
             bic,
         })
@@ -906,43 +936,46 @@ pub fn diagnose_key_drive(
     let mut tried_skipped: Vec<KeyCandidate> = Vec::new();
     for (c, spec) in options.library.iter().enumerate() {
         progress(&format!("trying {}", spec.id), (2.0 + c as f64) / steps);
-        // Screening: the grid at the baseline's calibration; the best point is refitted
-        // if it beats the baseline.
-        let mut screened: Option<(f64, Vec<f64>)> = None;
-        for values in grid_of(spec) {
-            let s = Setting {
-                effect: Some(ActionEffect {
-                    spec,
-                    values: values.clone(),
-                }),
-                ..rise.setting.clone()
-            };
-            let mut rss = 0.0;
-            for (r, (h, off)) in problem.fit_runs().zip(&s.runs) {
-                match problem.simulate(&s, r, *h, *off) {
-                    Ok(sim) => {
-                        rss += problem
-                            .whitened(r, &sim.predicted)
-                            .iter()
-                            .map(|w| w * w)
-                            .sum::<f64>()
+        // Screening: the grid at the rise's calibration and at the whole-run baseline's;
+        // the point that gains most on its own calibration's fit is refitted, if it
+        // gains at all.
+        let mut screened: Option<(f64, f64, Setting)> = None;
+        for (base_setting, base_rss) in [
+            (&rise.setting, rise_rss),
+            (&baseline.setting, baseline.fit.rss),
+        ] {
+            for values in grid_of(spec) {
+                let s = Setting {
+                    effect: Some(ActionEffect { spec, values }),
+                    ..base_setting.clone()
+                };
+                let mut rss = 0.0;
+                for (r, (h, off)) in problem.fit_runs().zip(&s.runs) {
+                    match problem.simulate(&s, r, *h, *off) {
+                        Ok(sim) => {
+                            rss += problem
+                                .whitened(r, &sim.predicted)
+                                .iter()
+                                .map(|w| w * w)
+                                .sum::<f64>()
+                        }
+                        Err(_) => rss = f64::INFINITY,
                     }
-                    Err(_) => rss = f64::INFINITY,
+                }
+                let gain = rss / base_rss;
+                if screened.as_ref().is_none_or(|(best, _, _)| gain < *best) {
+                    screened = Some((gain, rss - base_rss, s));
                 }
             }
-            if screened.as_ref().is_none_or(|(best, _)| rss < *best) {
-                screened = Some((rss, values));
-            }
         }
-        let Some((screen_rss, start_values)) = screened else {
+        let Some((gain, excess, start)) = screened else {
             continue;
         };
-        if screen_rss >= rise_rss {
+        if gain >= 1.0 {
             let n = baseline.fit.residuals.len() as f64;
-            let delta = n * (screen_rss / rise_rss).ln();
             tried_skipped.push(KeyCandidate {
                 id: spec.id.to_string(),
-                delta_bic: delta,
+                delta_bic: n * gain.ln(),
                 fit_rms_m: f64::NAN,
                 heldout_rms_m: None,
                 flagged_rms_m: f64::NAN,
@@ -952,19 +985,11 @@ pub fn diagnose_key_drive(
                 rival: false,
                 why: format!(
                     "dropped at screening: no strength over its plausible range improves on \
-                     the baseline (best whitened RSS {:+.0})",
-                    screen_rss - rise_rss
+                     the baseline (best whitened RSS {excess:+.0})"
                 ),
             });
             continue;
         }
-        let start = Setting {
-            effect: Some(ActionEffect {
-                spec,
-                values: start_values,
-            }),
-            ..rise.setting.clone()
-        };
         let best = problem.fit(&start, f64::INFINITY).ok();
         let Some(fitted) = best else { continue };
         let values = fitted
@@ -1173,10 +1198,10 @@ pub fn diagnose_key_drive(
             }
         }
     }
-    let free = problem.free_params(&baseline.setting)?;
+    let free = problem.free_params(&baseline.setting, false)?;
     let final_fit = chosen.map_or(&baseline, |b| &tried[b].fitted);
     let at_bound: Vec<String> = problem
-        .free_params(&final_fit.setting)?
+        .free_params(&final_fit.setting, false)?
         .into_iter()
         .zip(&final_fit.fit.at_bound)
         .filter(|(p, at)| **at && !p.name.starts_with("effects."))
@@ -1221,6 +1246,12 @@ pub fn diagnose_key_drive(
             });
         }
     }
+    let mut models: Vec<(&str, &Setting, &[(Vec<f64>, Simulated)])> =
+        vec![("baseline", &baseline.setting, &base_eval)];
+    if chosen.is_some() {
+        models.push(("corrected", after_setting, after_eval));
+    }
+    let replay = replay_data(&problem, &models).ok();
     lap("report", &mut since);
     Ok(KeyDriveDiagnosis {
         experiment: EXPERIMENT.to_string(),
@@ -1235,6 +1266,11 @@ pub fn diagnose_key_drive(
             .chain(tried_skipped)
             .collect(),
         calibrated,
+        rise_calibrated: CALIBRATED
+            .iter()
+            .zip(rise.setting.cal)
+            .map(|((name, _), v)| (name.to_string(), v))
+            .collect(),
         at_bound,
         calibration_frees: free.into_iter().map(|p| p.name).collect(),
         noise_floor_m: sigma,
@@ -1250,7 +1286,110 @@ pub fn diagnose_key_drive(
         data,
         timing,
         traces,
+        replay,
     })
+}
+
+/// Frames of the replay: one in this many camera frames [D]: 1 ms at 3000 fps.
+const REPLAY_EVERY: usize = 3;
+
+/// The replay's data: the action's drawing (the first model's), and per run the frame
+/// times, the phase of each, the measured markers (mm) and per model the motion of every
+/// drawn frame and its markers (mm).
+fn replay_data(
+    problem: &Problem<'_>,
+    models: &[(&str, &Setting, &[(Vec<f64>, Simulated)])],
+) -> Result<serde_json::Value> {
+    use serde_json::json;
+    let mm = |p: [f64; 2]| [(p[0] * 1e5).round() / 100.0, (p[1] * 1e5).round() / 100.0];
+    let mut scene = serde_json::Value::Null;
+    let mut runs = Vec::new();
+    for (i, r) in problem.runs.iter().enumerate() {
+        let picks: Vec<usize> = (0..r.times.len()).step_by(REPLAY_EVERY).collect();
+        let t: Vec<f64> = picks.iter().map(|&k| r.times[k]).collect();
+        let mut measured =
+            vec![vec![serde_json::Value::Null; picks.len()]; problem.dataset.markers.len()];
+        let mut seen = vec![vec![[f64::NAN; 2]; r.times.len()]; problem.dataset.markers.len()];
+        for o in &r.obs {
+            seen[o.marker][o.frame][o.axis] = o.value;
+        }
+        for (m, track) in seen.iter().enumerate() {
+            for (j, &k) in picks.iter().enumerate() {
+                if track[k].iter().all(|v| v.is_finite()) {
+                    measured[m][j] = json!(mm(track[k]));
+                }
+            }
+        }
+        let mut model_json = Vec::new();
+        let mut phase = Vec::new();
+        for (name, setting, eval) in models {
+            let sim = &eval[i].1;
+            let p = problem.params_of(&setting.cal)?;
+            let input = Input::MassDrop {
+                mass_kg: problem.mass_kg,
+                height_m: sim.height,
+            };
+            let f = |m: &mbs_mechanism::Mechanism| match &setting.effect {
+                Some(e) => e.apply(m, &p),
+                None => Ok(m.clone()),
+            };
+            let prepared = crate::simulate::prepare_transformed(
+                &p,
+                problem.kind,
+                &input,
+                setting
+                    .effect
+                    .as_ref()
+                    .map(|_| &f as crate::action::Transform),
+            )?;
+            let end = r.times.last().copied().unwrap_or(0.0) + OFFSET_TOLERANCE_S + 1e-3;
+            let action = &prepared.action;
+            let solution = action.integrate(&prepared.x0, end, 1e-3, Some(2e-4))?;
+            if scene.is_null() {
+                scene = crate::drawing::scene(action)?;
+            }
+            let mut carry: BTreeMap<String, [Vec<f64>; 3]> = BTreeMap::new();
+            for &tk in &t {
+                let ts = tk + sim.offset;
+                let j = solution
+                    .t
+                    .partition_point(|&s| s < ts)
+                    .min(solution.len() - 1);
+                for (frame, c) in crate::drawing::carry(action, solution.t[j], solution.state(j))? {
+                    let e = carry.entry(frame.to_string()).or_default();
+                    for a in 0..3 {
+                        e[a].push((c[a] * 1e4).round() / 1e4);
+                    }
+                }
+            }
+            let markers: Vec<Vec<[f64; 2]>> = sim
+                .frames
+                .iter()
+                .map(|track| picks.iter().map(|&k| mm(track[k])).collect())
+                .collect();
+            if phase.is_empty() {
+                phase = t
+                    .iter()
+                    .map(|&tk| {
+                        sim.phases
+                            .iter()
+                            .rev()
+                            .find(|ph| ph.from_s <= tk)
+                            .map_or("rise", |ph| ph.name)
+                    })
+                    .collect();
+            }
+            model_json.push(json!({"name": name, "carry": carry, "markers": markers}));
+        }
+        runs.push(
+            json!({"id": r.id, "t": t, "phase": phase, "measured": measured, "models": model_json}),
+        );
+    }
+    Ok(json!({
+        "scene": scene,
+        "markers": problem.dataset.markers.iter().map(|m| m.name.clone()).collect::<Vec<_>>(),
+        "runs": runs,
+    }))
 }
 
 /// A marker's gap over 10 ms above this many noise floors marks the onset [D]: with

@@ -10,6 +10,7 @@ pub mod diagnose;
 pub mod effects;
 pub mod key_diagnose;
 pub mod key_drive;
+pub mod key_report;
 pub mod report;
 pub mod swing_model;
 pub mod synth;

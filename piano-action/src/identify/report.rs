@@ -23,7 +23,7 @@ pub fn check_out_dir(dir: &Path, force: bool) -> Result<()> {
 }
 
 /// How page `name` marks that `piano diagnose` wrote it.
-fn generator_mark(name: &str) -> String {
+pub(super) fn generator_mark(name: &str) -> String {
     if name.ends_with(".json") {
         format!("\"generator\": \"{GENERATOR}\"")
     } else if name.ends_with(".html") {
