@@ -203,6 +203,10 @@ enum Command {
         /// comma-separated), one run each; the first is fitted, the others held out.
         #[arg(long, default_value = "0,5", allow_hyphen_values = true)]
         heights: String,
+        /// Key drive: the markers tracked (comma-separated; default all: key_front,
+        /// key_back, hammer_head, hammer_shank); key_front, the drive, must be one.
+        #[arg(long)]
+        markers: Option<String>,
         /// Key drive: the mass released on the key (kg).
         #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         mass: f64,
@@ -1053,10 +1057,7 @@ fn diagnose(
         library: commands::library(library).map_err(|e| e.to_string())?,
         ..DiagnoseOptions::default()
     };
-    let bar = indicatif::ProgressBar::new(100);
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:30} {msg} ({elapsed})") {
-        bar.set_style(style);
-    }
+    let bar = stage_bar();
     let progress = |msg: &str, fraction: f64| {
         bar.set_message(msg.to_string());
         bar.set_position((fraction * 100.0) as u64);
@@ -1102,6 +1103,15 @@ fn diagnose(
     Ok(())
 }
 
+/// A progress bar for a diagnosis's stages (0–100).
+fn stage_bar() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(100);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:30} {msg} ({elapsed})") {
+        bar.set_style(style);
+    }
+    bar
+}
+
 /// `piano diagnose` on a key-drive dataset.
 fn diagnose_key_drive(
     params: &piano_action::params::ActionParams,
@@ -1124,10 +1134,7 @@ fn diagnose_key_drive(
         library: commands::action_library(library).map_err(|e| e.to_string())?,
         ..KeyDiagnoseOptions::default()
     };
-    let bar = indicatif::ProgressBar::new(100);
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{bar:30} {msg} ({elapsed})") {
-        bar.set_style(style);
-    }
+    let bar = stage_bar();
     let progress = |msg: &str, fraction: f64| {
         bar.set_message(msg.to_string());
         bar.set_position((fraction * 100.0) as u64);
@@ -1195,7 +1202,7 @@ fn synth(
     experiment: &str,
     effect: Option<&str>,
     seed: u64,
-    (releases, heights, mass): (&str, &str, f64),
+    (releases, heights, mass, markers): (&str, &str, f64, Option<&str>),
     duration: Option<f64>,
     out: &std::path::Path,
     truth: &std::path::Path,
@@ -1212,7 +1219,15 @@ fn synth(
             .collect::<Result<Vec<_>, _>>()
     };
     match experiment {
-        "pendulum" => {}
+        "pendulum" => {
+            if markers.is_some() {
+                return Err(
+                    "option --markers: the key drive's; a pendulum dataset tracks \
+                            the hammer's head and shank"
+                        .into(),
+                );
+            }
+        }
         key_drive::EXPERIMENT => {
             let effect = effect
                 .map(piano_action::identify::action_effects::ActionEffect::parse)
@@ -1227,6 +1242,14 @@ fn synth(
                     .collect(),
                 duration_s: duration.unwrap_or(0.3),
                 effect,
+                markers: markers
+                    .map(|m| {
+                        m.split(',')
+                            .map(|s| s.trim().to_string())
+                            .filter(|s| !s.is_empty())
+                            .collect()
+                    })
+                    .unwrap_or_default(),
                 ..Default::default()
             };
             commands::synth_key_drive_to_disk(params, &options, out, truth, force)
@@ -1349,6 +1372,7 @@ fn main() -> ExitCode {
                 seed,
                 releases,
                 heights,
+                markers,
                 mass,
                 duration,
                 out,
@@ -1359,7 +1383,7 @@ fn main() -> ExitCode {
                 &experiment,
                 effect.as_deref(),
                 seed,
-                (&releases, &heights, mass),
+                (&releases, &heights, mass, markers.as_deref()),
                 duration,
                 &out,
                 &truth,

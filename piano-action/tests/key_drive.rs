@@ -173,12 +173,37 @@ fn piano_synth_writes_a_key_drive_dataset() {
     let t: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&truth).unwrap()).unwrap();
     assert!(t["nuisance"]["hammer.mass_g"].is_number());
-    // Nothing is replaced without --force; effects are not in this experiment's library
-    // yet; an unknown experiment is named.
+    // Nothing is replaced without --force; an effect of the action family goes into the
+    // truth; one of the swing test's, or out of its plausible range, is refused by name;
+    // an unknown experiment is named.
     let (ok, _, err) = run(args(&["--duration", "0.1"]));
     assert!(!ok && err.contains("--force"), "{err}");
-    let (ok, _, err) = run(args(&["--effect", "key_flex", "--force"]));
-    assert!(!ok && err.contains("no effect library yet"), "{err}");
+    let (ok, _, err) = run(args(&[
+        "--effect",
+        "shank_flex:compliance_rad_n_m=0.1",
+        "--heights",
+        "0",
+        "--duration",
+        "0.1",
+        "--force",
+    ]));
+    assert!(ok, "{err}");
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&truth).unwrap()).unwrap();
+    assert_eq!(t["effect"], "shank_flex");
+    assert_eq!(t["effect_params"]["compliance_rad_n_m"], 0.1);
+    assert_eq!(t["effect_params"]["zeta"], 0.05);
+    let (ok, _, err) = run(args(&["--effect", "air_drag", "--force"]));
+    assert!(
+        !ok && err.contains("no effect 'air_drag'") && err.contains("key_flex"),
+        "{err}"
+    );
+    let (ok, _, err) = run(args(&[
+        "--effect",
+        "key_flex:compliance_rad_n_m=1",
+        "--force",
+    ]));
+    assert!(!ok && err.contains("plausible range"), "{err}");
     let (ok, _, err) = piano(&[
         "synth",
         "--experiment",
@@ -189,36 +214,6 @@ fn piano_synth_writes_a_key_drive_dataset() {
         truth.to_str().unwrap(),
     ]);
     assert!(!ok && err.contains("'typebar'"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
-}
-
-/// `piano diagnose` says plainly that it cannot diagnose a key drive yet.
-#[test]
-fn diagnose_says_a_key_drive_is_not_diagnosed_yet() {
-    let params = ActionParams::reference();
-    let (dataset, runs, _) = synthesize(
-        &params,
-        &KeyDriveOptions {
-            release_heights_m: vec![0.0],
-            duration_s: 0.05,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let dir = std::env::temp_dir().join(format!("piano-kd-diagnose-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dataset.write(&dir, &runs).unwrap();
-    let out = dir.join("diag");
-    let (ok, _, err) = piano(&[
-        "diagnose",
-        dir.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(
-        !ok && err.contains("their diagnosis is not built yet"),
-        "{err}"
-    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -148,7 +148,7 @@ pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
         unit: "",
         null: Some(0.0),
         range: [0.0, 0.6],
-        typical: 0.05,
+        typical: 0.15,
         log_scale: false,
     }],
     confusable_with: &["felt_hysteresis"],

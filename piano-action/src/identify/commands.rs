@@ -120,52 +120,48 @@ fn check_synth_paths(out: &Path, truth: &Path, force: bool) -> Result<()> {
     Ok(())
 }
 
-/// The library restricted to `ids` (comma-separated; all when `None`).
+/// The swing test's library restricted to `ids` (comma-separated; all when `None`).
 pub fn library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::EffectSpec>> {
-    let Some(ids) = ids else {
-        return Ok(PENDULUM_EFFECTS.iter().collect());
-    };
-    let mut out: Vec<&'static mbs_identify::EffectSpec> = Vec::new();
-    for id in ids.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let spec = super::effects::effect_spec(id).ok_or_else(|| {
-            PianoError::option(
-                "--library",
-                format!("no effect '{id}' in the library (known: {})", library_ids()),
-            )
-        })?;
-        if out.iter().any(|s| s.id == spec.id) {
-            return Err(PianoError::option(
-                "--library",
-                format!("'{id}' is listed twice"),
-            ));
-        }
-        out.push(spec);
-    }
-    if out.is_empty() {
-        return Err(PianoError::option(
-            "--library",
-            format!("names no effect (known: {})", library_ids()),
-        ));
-    }
-    Ok(out)
+    library_of(
+        ids,
+        &PENDULUM_EFFECTS,
+        super::effects::effect_spec,
+        &library_ids(),
+        "library",
+    )
 }
 
 /// The action family restricted to `ids` (comma-separated; all when `None`), for a
 /// key-drive diagnosis.
 pub fn action_library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::EffectSpec>> {
     use super::action_effects::{ACTION_EFFECTS, action_effect_spec, action_library_ids};
+    library_of(
+        ids,
+        &ACTION_EFFECTS,
+        action_effect_spec,
+        &action_library_ids(),
+        "key-drive library",
+    )
+}
+
+/// `all` restricted to `ids` (comma-separated; all when `None`), each found by `lookup`;
+/// messages list `known` and name the library `what`.
+fn library_of(
+    ids: Option<&str>,
+    all: &'static [mbs_identify::EffectSpec],
+    lookup: fn(&str) -> Option<&'static mbs_identify::EffectSpec>,
+    known: &str,
+    what: &str,
+) -> Result<Vec<&'static mbs_identify::EffectSpec>> {
     let Some(ids) = ids else {
-        return Ok(ACTION_EFFECTS.iter().collect());
+        return Ok(all.iter().collect());
     };
     let mut out: Vec<&'static mbs_identify::EffectSpec> = Vec::new();
     for id in ids.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let spec = action_effect_spec(id).ok_or_else(|| {
+        let spec = lookup(id).ok_or_else(|| {
             PianoError::option(
                 "--library",
-                format!(
-                    "no effect '{id}' in the key-drive library (known: {})",
-                    action_library_ids()
-                ),
+                format!("no effect '{id}' in the {what} (known: {known})"),
             )
         })?;
         if out.iter().any(|s| s.id == spec.id) {
@@ -179,7 +175,7 @@ pub fn action_library(ids: Option<&str>) -> Result<Vec<&'static mbs_identify::Ef
     if out.is_empty() {
         return Err(PianoError::option(
             "--library",
-            format!("names no effect (known: {})", action_library_ids()),
+            format!("names no effect (known: {known})"),
         ));
     }
     Ok(out)

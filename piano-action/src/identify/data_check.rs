@@ -341,3 +341,31 @@ pub(super) fn noise_floor(file: &std::path::Path, runs: &[Run], markers: usize) 
         message: "too few frames to estimate the tracking noise".into(),
     })
 }
+
+impl DataCheck {
+    /// The data check of `runs` of `dataset`, with the noise floor `noise`.
+    pub(super) fn of(dataset: &mbs_identify::Dataset, runs: &[Run], noise: &Ar1) -> DataCheck {
+        DataCheck {
+            noise_floor_m: noise.sigma,
+            rho: noise.rho,
+            declared_sigma_m: dataset
+                .markers
+                .iter()
+                .map(|m| m.sigma_m)
+                .fold(0.0, f64::max),
+            runs: runs
+                .iter()
+                .map(|r| RunCheck {
+                    id: r.id.clone(),
+                    role: match r.role {
+                        Role::Fit => "fit".into(),
+                        Role::Heldout => "heldout".into(),
+                    },
+                    frames: r.times.len(),
+                    lost_frames: r.lost_frames,
+                    outlier_frames: r.outlier_frames.len(),
+                })
+                .collect(),
+        }
+    }
+}

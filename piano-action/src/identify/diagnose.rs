@@ -554,29 +554,7 @@ pub fn diagnose(
         threads: options.threads.max(1),
     };
     let sigma = noise.sigma;
-    let data = DataCheck {
-        noise_floor_m: sigma,
-        rho: noise.rho,
-        declared_sigma_m: dataset
-            .markers
-            .iter()
-            .map(|m| m.sigma_m)
-            .fold(0.0, f64::max),
-        runs: problem
-            .runs
-            .iter()
-            .map(|r| RunCheck {
-                id: r.id.clone(),
-                role: match r.role {
-                    Role::Fit => "fit".into(),
-                    Role::Heldout => "heldout".into(),
-                },
-                frames: r.times.len(),
-                lost_frames: r.lost_frames,
-                outlier_frames: r.outlier_frames.len(),
-            })
-            .collect(),
-    };
+    let data = DataCheck::of(dataset, &problem.runs, &noise);
     let steps = 2.0 + options.library.len() as f64;
 
     // A. The baseline: inertia, Coulomb friction, each fitted run's release and offset;

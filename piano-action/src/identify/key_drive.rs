@@ -75,6 +75,9 @@ pub struct KeyDriveOptions {
     pub nuisance: bool,
     /// The hidden effect, if any.
     pub effect: Option<ActionEffect>,
+    /// The markers tracked, by name (empty: all of [`default_markers`]); the drive must be
+    /// one.
+    pub markers: Vec<String>,
 }
 
 impl Default for KeyDriveOptions {
@@ -88,6 +91,7 @@ impl Default for KeyDriveOptions {
             camera: CameraSynth::default(),
             nuisance: true,
             effect: None,
+            markers: Vec::new(),
         }
     }
 }
@@ -182,6 +186,24 @@ fn check(o: &KeyDriveOptions) -> Result<()> {
         return bad("--duration", format!("{} s: 0.05 to 2 s", o.duration_s));
     }
     check_camera(&o.camera)?;
+    let known: Vec<String> = default_markers(&ActionParams::reference(), 1.0)
+        .into_iter()
+        .map(|m| m.name)
+        .collect();
+    for m in &o.markers {
+        if !known.contains(m) {
+            return bad(
+                "--markers",
+                format!("no marker '{m}' (markers: {})", known.join(", ")),
+            );
+        }
+    }
+    if !o.markers.is_empty() && !o.markers.iter().any(|m| m == DRIVE_MARKER) {
+        return bad(
+            "--markers",
+            format!("the drive, '{DRIVE_MARKER}', must be among them"),
+        );
+    }
     Ok(())
 }
 
@@ -288,7 +310,10 @@ pub fn synthesize(
     } else {
         (params.clone(), BTreeMap::new())
     };
-    let markers = default_markers(params, options.camera.sigma_m);
+    let mut markers = default_markers(params, options.camera.sigma_m);
+    if !options.markers.is_empty() {
+        markers.retain(|m| options.markers.contains(&m.name));
+    }
     let frames = (options.duration_s * options.camera.fps).round() as usize;
     let times: Vec<f64> = (0..frames).map(|k| k as f64 / options.camera.fps).collect();
     let (mut specs, mut runs, mut truth_runs) = (Vec::new(), Vec::new(), Vec::new());
@@ -781,92 +806,5 @@ mod tests {
             .map(|(&t, v)| (v.expect("every frame") - truth(t)).abs())
             .fold(0.0, f64::max);
         assert!(worst < 1e-5, "worst error {worst:e} (gross error 1e-3)");
-    }
-}
-
-#[cfg(test)]
-mod probe {
-    use super::*;
-    use crate::identify::action_effects::ACTION_EFFECTS;
-
-    /// How much each effect at its typical strength moves each marker, by phase of the
-    /// baseline (a probe for choosing strengths; prints).
-    #[test]
-    #[ignore]
-    fn effect_visibility() {
-        let params = ActionParams::reference();
-        let markers = default_markers(&params, 3e-5);
-        let input = Input::MassDrop {
-            mass_kg: 1.0,
-            height_m: 0.0,
-        };
-        let t0 = std::time::Instant::now();
-        let base = simulate_effect(&params, ModelKind::Double, &input, 0.3, None).unwrap();
-        eprintln!("one sim {:?}", t0.elapsed());
-        let (bt, btr) =
-            marker_tracks_of(&params, ModelKind::Double, &input, &base, &markers, None).unwrap();
-        let ev: Vec<(String, f64)> = base
-            .events
-            .iter()
-            .map(|e| (e.name.to_string(), e.time_s))
-            .collect();
-        eprintln!("events {ev:?}");
-        let report = |name: &str, et: &[f64], etr: &CleanTracks| {
-            let mut line = format!("{name:50}");
-            for (m, mk) in markers.iter().enumerate() {
-                let mut win = [0.0f64; 6];
-                let mut cnt = [0usize; 6];
-                for k in 0..900 {
-                    let t = k as f64 / 3000.0;
-                    let a = at(&bt, &btr[m], t);
-                    let b = at(et, &etr[m], t);
-                    let d = (a[0] - b[0]).hypot(a[1] - b[1]);
-                    let w = (t / 0.05) as usize;
-                    win[w.min(5)] += d * d;
-                    cnt[w.min(5)] += 1;
-                }
-                line += &format!(" {}:", mk.name);
-                for w in 0..6 {
-                    line += &format!(" {:.0}", 1e6 * (win[w] / cnt[w] as f64).sqrt());
-                }
-            }
-            eprintln!("{line}");
-        };
-        for seed in 1..6 {
-            let mut rng = Rng::new(seed);
-            let (p2, _) = mismatched(&params, &mut rng).unwrap();
-            let (et, etr) =
-                marker_tracks(&p2, ModelKind::Double, &input, 0.3, &markers, None).unwrap();
-            report(&format!("nuisance seed {seed}"), &et, &etr);
-        }
-        let arg = std::env::var("EFFECTS").unwrap_or_default();
-        for spec in &ACTION_EFFECTS {
-            let text = arg
-                .split(';')
-                .find(|s| s.starts_with(spec.id))
-                .unwrap_or(spec.id);
-            let e = ActionEffect::parse(text).unwrap();
-            let (et, etr) =
-                marker_tracks(&params, ModelKind::Double, &input, 0.3, &markers, Some(&e)).unwrap();
-            let mut line = format!("{text:50}");
-            for (m, mk) in markers.iter().enumerate() {
-                let mut win = [0.0f64; 6];
-                let mut cnt = [0usize; 6];
-                for k in 0..900 {
-                    let t = k as f64 / 3000.0;
-                    let a = at(&bt, &btr[m], t);
-                    let b = at(&et, &etr[m], t);
-                    let d = (a[0] - b[0]).hypot(a[1] - b[1]);
-                    let w = (t / 0.05) as usize;
-                    win[w.min(5)] += d * d;
-                    cnt[w.min(5)] += 1;
-                }
-                line += &format!(" {}:", mk.name);
-                for w in 0..6 {
-                    line += &format!(" {:.0}", 1e6 * (win[w] / cnt[w] as f64).sqrt());
-                }
-            }
-            eprintln!("{line}");
-        }
     }
 }

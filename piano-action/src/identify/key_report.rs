@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::key_diagnose::KeyDriveDiagnosis;
-use super::report::{FILES, check_out_dir, generator_mark};
+use super::report::{FILES, calibrated_table, check_out_dir, data_items, generator_mark};
 use crate::error::{PianoError, Result};
 use crate::validate::page::PAGE_STYLE;
 use crate::validate::svg::{Axis, Chart, Corner, Mark, Series, escape};
@@ -401,26 +401,12 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             escape(&c.why)
         );
     }
-    s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n<table><tbody>\n");
-    for (path, v) in &d.calibrated {
-        let _ = writeln!(
-            s,
-            "<tr><td><code>{}</code></td><td class=\"num\">{v:.6e}</td></tr>",
-            escape(path)
-        );
-    }
-    s.push_str("</tbody></table>\n<h2>Data and time</h2>\n<ul>\n");
-    for r in &d.data.runs {
-        let _ = writeln!(
-            s,
-            "<li><code>{}</code> ({}): {} frames, {} with a marker lost, {} outliers left out</li>",
-            escape(&r.id),
-            r.role,
-            r.frames,
-            r.lost_frames,
-            r.outlier_frames
-        );
-    }
+    s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n");
+    s.push_str(&calibrated_table(&d.calibrated));
+    s.push_str("<p>On the rise alone:</p>\n");
+    s.push_str(&calibrated_table(&d.rise_calibrated));
+    s.push_str("<h2>Data and time</h2>\n<ul>\n");
+    s.push_str(&data_items(&d.data));
     for (stage, t) in &d.timing {
         let _ = writeln!(s, "<li>{}: {t:.1} s</li>", escape(stage));
     }

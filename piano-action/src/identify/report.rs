@@ -414,16 +414,32 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
             escape(&c.why)
         );
     }
-    s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n<table><tbody>\n");
-    for (path, v) in &d.calibrated {
+    s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n");
+    s.push_str(&calibrated_table(&d.calibrated));
+    s.push_str("<h2>Data</h2>\n<ul>\n");
+    s.push_str(&data_items(&d.data));
+    s.push_str("</ul>\n</body>\n</html>\n");
+    s
+}
+
+/// The calibrated values as an HTML table.
+pub(super) fn calibrated_table(values: &std::collections::BTreeMap<String, f64>) -> String {
+    let mut s = String::from("<table><tbody>\n");
+    for (path, v) in values {
         let _ = writeln!(
             s,
             "<tr><td><code>{}</code></td><td class=\"num\">{v:.6e}</td></tr>",
             escape(path)
         );
     }
-    s.push_str("</tbody></table>\n<h2>Data</h2>\n<ul>\n");
-    for r in &d.data.runs {
+    s.push_str("</tbody></table>\n");
+    s
+}
+
+/// The data check's runs as HTML list items.
+pub(super) fn data_items(data: &super::data_check::DataCheck) -> String {
+    let mut s = String::new();
+    for r in &data.runs {
         let _ = writeln!(
             s,
             "<li><code>{}</code> ({}): {} frames, {} with a marker lost, {} outliers left out</li>",
@@ -434,6 +450,5 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
             r.outlier_frames
         );
     }
-    s.push_str("</ul>\n</body>\n</html>\n");
     s
 }

@@ -1,0 +1,243 @@
+//! The key-drive diagnosis (issue 15) on synthetic data with a hidden effect: the CI tier
+//! runs short drops with a reduced library; the study over seeds is `--ignored` (the
+//! nightly tier of `identification.md` §5.4) and prints its confusion table.
+
+mod common;
+
+use common::piano;
+use mbs_identify::Dataset;
+use piano_action::identify::action_effects::{ActionEffect, action_effect_spec};
+use piano_action::identify::key_diagnose::{KeyDiagnoseOptions, diagnose_key_drive};
+use piano_action::identify::key_drive::{KeyDriveOptions, synthesize};
+use piano_action::params::ActionParams;
+
+/// Writes a synthetic key-drive dataset into a fresh temporary folder and reads it back.
+fn dataset(tag: &str, options: &KeyDriveOptions) -> (Dataset, std::path::PathBuf) {
+    let params = ActionParams::reference();
+    let (dataset, runs, _) = synthesize(&params, options).expect("synthesises");
+    let dir = std::env::temp_dir().join(format!("piano-kdiag-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dataset.write(&dir, &runs).expect("writes");
+    (Dataset::load(&dir).expect("reads back"), dir)
+}
+
+fn options(ids: &[&str]) -> KeyDiagnoseOptions {
+    KeyDiagnoseOptions {
+        library: ids
+            .iter()
+            .map(|id| action_effect_spec(id).expect("in the library"))
+            .collect(),
+        ..KeyDiagnoseOptions::default()
+    }
+}
+
+/// A key that bends (its back arm on a spring of 3300 N·m/rad, close to a basswood key's
+/// estimated stiffness) is found and named among three candidates on one 0.15 s drop
+/// tracked at the key front and back and the hammer head and shank; the gap comes down to
+/// within 1.5 noise floors, and the bending's compliance within a factor 3.
+#[test]
+fn a_bending_key_is_named() {
+    let (ds, dir) = dataset(
+        "flex",
+        &KeyDriveOptions {
+            seed: 1,
+            release_heights_m: vec![0.0],
+            duration_s: 0.15,
+            effect: Some(ActionEffect::parse("key_flex").expect("parses")),
+            ..KeyDriveOptions::default()
+        },
+    );
+    let params = ActionParams::reference();
+    let d = diagnose_key_drive(
+        &params,
+        &ds,
+        &options(&["key_flex", "knuckle_friction", "felt_hysteresis"]),
+        &|_, _| {},
+    )
+    .expect("diagnoses");
+    assert_eq!(d.decision, "named", "{}", d.summary);
+    assert_eq!(d.effects[0].id, "key_flex");
+    let c = d.effects[0].params["compliance_rad_n_m"];
+    assert!((1e-4..9e-4).contains(&c), "compliance {c:e} (truth 3e-4)");
+    assert!(
+        d.after_rms_m < 1.5 * d.noise_floor_m,
+        "gap {:.1} µm against a floor of {:.1}",
+        d.after_rms_m * 1e6,
+        d.noise_floor_m * 1e6
+    );
+    assert!(d.before_rms_m > 1.3 * d.after_rms_m);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The file's own action, camera noise and nuisance only: nothing is added.
+#[test]
+fn nothing_is_added_to_an_action_without_a_hidden_effect() {
+    let (ds, dir) = dataset(
+        "none",
+        &KeyDriveOptions {
+            seed: 2,
+            release_heights_m: vec![0.0],
+            duration_s: 0.15,
+            ..KeyDriveOptions::default()
+        },
+    );
+    let params = ActionParams::reference();
+    let d = diagnose_key_drive(
+        &params,
+        &ds,
+        &options(&["key_flex", "knuckle_friction", "felt_hysteresis"]),
+        &|_, _| {},
+    )
+    .expect("diagnoses");
+    assert_eq!(d.decision, "none", "{}", d.summary);
+    assert!(d.effects.is_empty());
+    assert!(d.before_rms_m < 1.5 * d.noise_floor_m);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `piano diagnose` reads a key-drive dataset, writes its three pages (the replay in the
+/// HTML), refuses `--write-params` and a dataset without its mass, naming the field.
+#[test]
+fn the_cli_diagnoses_a_key_drive_and_refuses_what_it_cannot_do() {
+    let (_, dir) = dataset(
+        "cli",
+        &KeyDriveOptions {
+            seed: 3,
+            release_heights_m: vec![0.0],
+            duration_s: 0.1,
+            ..KeyDriveOptions::default()
+        },
+    );
+    let out = dir.join("report");
+    let (ok, stdout, err) = piano(&[
+        "diagnose",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--library",
+        "knuckle_friction",
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("decision: "), "{stdout}");
+    assert!(stdout.contains("time: "), "{stdout}");
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    assert!(html.contains("const REPLAY = {"), "the replay's data");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["experiment"], "key_drive");
+    assert!(json["phases"].as_array().is_some_and(|p| !p.is_empty()));
+    // A parameter file cannot hold a split key.
+    let (ok, _, err) = piano(&[
+        "diagnose",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+        "--write-params",
+        dir.join("c.toml").to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("--write-params"), "{err}");
+    // An effect of the other library is named as such.
+    let (ok, _, err) = piano(&[
+        "diagnose",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+        "--library",
+        "air_drag",
+    ]);
+    assert!(!ok && err.contains("key-drive library"), "{err}");
+    // Without its mass the key cannot be driven.
+    let json_path = dir.join("dataset.json");
+    let text = std::fs::read_to_string(&json_path).unwrap();
+    std::fs::write(&json_path, text.replace("\"mass_kg\"", "\"weight\"")).unwrap();
+    let (ok, _, err) = piano(&[
+        "diagnose",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(
+        !ok && err.contains("dataset.json") && err.contains("conditions.mass_kg"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The study of issue 15 (nightly tier, about 2 minutes per dataset): 5 seeds of each
+/// effect at its visible strength and 5 negatives, two drops of 0.3 s tracked at the key
+/// front and back and the hammer head and shank; prints the outcomes and the rates the
+/// issue asks for, and checks them: the right effect (or an ambiguity holding it) in
+/// ≥ 80 %, a wrong confident name in ≤ 10 %, `none` in ≥ 80 % of the negatives.
+#[test]
+#[ignore]
+fn study_over_seeds() {
+    let params = ActionParams::reference();
+    let seeds: u64 = std::env::var("STUDY_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
+    let effects: Vec<Option<&str>> = std::iter::once(None)
+        .chain(
+            piano_action::identify::action_effects::ACTION_EFFECTS
+                .iter()
+                .map(|e| Some(e.id)),
+        )
+        .collect();
+    let (mut right, mut wrong, mut total, mut none_ok, mut negatives) = (0, 0, 0, 0, 0);
+    for effect in effects {
+        for seed in 1..=seeds {
+            let (ds, dir) = dataset(
+                &format!("study-{}-{seed}", effect.unwrap_or("none")),
+                &KeyDriveOptions {
+                    seed,
+                    effect: effect.map(|e| ActionEffect::parse(e).expect("parses")),
+                    ..KeyDriveOptions::default()
+                },
+            );
+            let d = diagnose_key_drive(&params, &ds, &KeyDiagnoseOptions::default(), &|_, _| {})
+                .expect("diagnoses");
+            let named: Vec<String> = d
+                .effects
+                .iter()
+                .map(|e| e.id.clone())
+                .chain(d.ambiguous_with.iter().cloned())
+                .collect();
+            let post = piano_action::identify::key_report::post_check_gap(&d)
+                .map_or(String::new(), |(b, a)| format!(" post-check {:.1}x", b / a));
+            let secs: f64 = d.timing.iter().map(|(_, t)| t).sum();
+            eprintln!(
+                "{:22} seed {seed}: {:11} {:40} gap {:.0} -> {:.0} um{post} ({secs:.0} s)",
+                effect.unwrap_or("none"),
+                d.decision,
+                named.join(" | "),
+                d.before_rms_m * 1e6,
+                d.after_rms_m * 1e6
+            );
+            match effect {
+                None => {
+                    negatives += 1;
+                    none_ok += usize::from(d.decision == "none");
+                }
+                Some(id) => {
+                    total += 1;
+                    if named.iter().any(|n| n == id) {
+                        right += 1;
+                    } else if d.decision == "named" {
+                        wrong += 1;
+                    }
+                }
+            }
+            std::fs::remove_dir_all(&dir).ok();
+        }
+    }
+    eprintln!(
+        "right (named or in the ambiguity): {right}/{total}; wrong confident name: \
+         {wrong}/{total}; none on negatives: {none_ok}/{negatives}"
+    );
+    assert!(right * 5 >= total * 4, "right {right}/{total}");
+    assert!(wrong * 10 <= total, "wrong {wrong}/{total}");
+    assert!(none_ok * 5 >= negatives * 4, "none {none_ok}/{negatives}");
+}
