@@ -1155,7 +1155,7 @@ fn diagnose_key_drive(
     );
     if let Some((b, a)) = key_report::post_check_gap(&d) {
         println!(
-            "post-check gap: {:.1} -> {:.1} um ({:.1}x)",
+            "gap after the check's catch: {:.1} -> {:.1} um ({:.1}x)",
             b * 1e6,
             a * 1e6,
             b / a.max(1e-300)

@@ -956,21 +956,31 @@ pub fn diagnose_key_drive(
     let rise_raw = raw(r0, &rise_sim.predicted);
     let base_phases = base_eval[f0].1.phases.clone();
     let mut flagged: Option<(usize, f64)> = None;
-    for (k, ph) in rise_sim.phases.iter().enumerate() {
-        let g = window_rms(r0, &rise_raw, ph.from_s, ph.to_s, None);
+    // The flagged phase: the whole-run baseline's largest gap (what the effect must
+    // shrink); the onset: where the rise's calibration stops predicting.
+    for (k, ph) in base_phases.iter().enumerate() {
+        let g = window_rms(r0, &base_eval[f0].0, ph.from_s, ph.to_s, None);
         if flagged.is_none_or(|(_, best)| g > best) {
             flagged = Some((k, g));
         }
     }
     let flag_k = flagged.map_or(0, |f| f.0);
-    let flag_phase = rise_sim.phases.get(flag_k).cloned().unwrap_or(Phase {
+    let flag_phase = base_phases.get(flag_k).cloned().unwrap_or(Phase {
         name: "rise",
         from_s: 0.0,
         to_s: f64::INFINITY,
     });
     let flag_marker = (0..dataset.markers.len())
         .max_by(|&a, &b| {
-            let g = |m| window_rms(r0, &rise_raw, flag_phase.from_s, flag_phase.to_s, Some(m));
+            let g = |m| {
+                window_rms(
+                    r0,
+                    &base_eval[f0].0,
+                    flag_phase.from_s,
+                    flag_phase.to_s,
+                    Some(m),
+                )
+            };
             g(a).total_cmp(&g(b))
         })
         .unwrap_or(0);

@@ -76,7 +76,9 @@ fn onset_text(d: &KeyDriveDiagnosis) -> String {
     }
 }
 
-/// The post-check gap (m) of the fitted runs, before and after, if there is one.
+/// The gap after the check's catch (m; the check and post-check phases of the fitted runs,
+/// every marker), before and after, if the hammer was caught: the seed study's "after the
+/// check".
 pub fn post_check_gap(d: &KeyDriveDiagnosis) -> Option<(f64, f64)> {
     let fit: Vec<&str> = d
         .data
@@ -88,7 +90,9 @@ pub fn post_check_gap(d: &KeyDriveDiagnosis) -> Option<(f64, f64)> {
     let cells: Vec<_> = d
         .phases
         .iter()
-        .filter(|p| p.phase == "post_check" && fit.contains(&p.run.as_str()))
+        .filter(|p| {
+            (p.phase == "check" || p.phase == "post_check") && fit.contains(&p.run.as_str())
+        })
         .collect();
     if cells.is_empty() {
         return None;
@@ -150,7 +154,7 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     if let Some((b, a)) = post_check_gap(d) {
         let _ = writeln!(
             s,
-            "Post-check gap (fitted runs, every marker): {} → {} µm ({:.1}×).\n",
+            "Gap after the check's catch (fitted runs, every marker): {} → {} µm ({:.1}×).\n",
             um(b),
             um(a),
             b / a.max(1e-300)
@@ -335,7 +339,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
         escape(&d.flagged_marker),
         escape(&onset_text(d)),
         post_check_gap(d).map_or(String::new(), |(b, a)| format!(
-            " Post-check gap: {} → {} µm ({:.1}×).",
+            " Gap after the check's catch: {} → {} µm ({:.1}×).",
             um(b),
             um(a),
             b / a.max(1e-300)
