@@ -113,6 +113,10 @@ pub const FD_STEP: f64 = 1e-2;
 /// calibration, the screening's best point) and each step costs a Jacobian.
 pub const MAX_ITERATIONS: usize = 15;
 
+/// The most accepted steps of a screening point's rise recalibration [D]: it starts from
+/// the baseline's rise, a few steps from its optimum.
+pub const SCREEN_RISE_ITERATIONS: usize = 6;
+
 /// How much worse the held-out run may get with a kept effect [D]. The swing test asks it
 /// to improve by 10 %; a drop's held-out run cannot: after the check its hammer rides a
 /// friction wedge whose release a model right to a per cent can miss by milliseconds, and
@@ -422,7 +426,21 @@ struct Simulated {
     phases: Vec<Phase>,
 }
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
+    /// A copy sharing the parameters and the dataset (the runs cloned).
+    fn shallow(&self) -> Problem<'a> {
+        Problem {
+            params: self.params,
+            dataset: self.dataset,
+            runs: self.runs.clone(),
+            noise: self.noise,
+            mass_kg: self.mass_kg,
+            kind: self.kind,
+            threads: self.threads,
+            rise_end: self.rise_end,
+        }
+    }
+
     /// The parameter file with the calibrated values of `cal`.
     fn params_of(&self, cal: &[f64; 5]) -> Result<ActionParams> {
         let mut p = self.params.clone();
@@ -1015,29 +1033,51 @@ pub fn diagnose_key_drive(
         // effect in (an effect that acts in the rise would otherwise hide in the
         // calibration), the back-check's friction taken from the baseline; the point
         // that fits the whole run best is refitted, if it beats the baseline.
-        let mut screened: Option<(f64, Setting)> = None;
-        for values in grid_of(spec) {
+        // The points are independent: they run side by side (each fit's Jacobian is
+        // serial here), and the best is taken in grid order, whatever finished first.
+        let screen_point = |values: Vec<f64>| -> Option<(f64, Setting)> {
             let start = Setting {
                 effect: Some(ActionEffect { spec, values }),
                 ..rise.setting.clone()
             };
-            let Ok(recalibrated) = problem.fit(&start, Stage::Rise) else {
-                continue;
+            let serial = Problem {
+                threads: 1,
+                ..problem.shallow()
             };
+            let recalibrated = serial
+                .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS)
+                .ok()?;
             let mut s = recalibrated.setting;
             for j in RISE_HELD {
                 s.cal[j] = baseline.setting.cal[j];
             }
             // What the rise cannot see, refitted briefly with the effect in: the baseline
             // has had the chance to hide the effect in it.
-            let Ok(whole) = problem.fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS) else {
-                continue;
-            };
-            if screened
-                .as_ref()
-                .is_none_or(|(best, _)| whole.fit.rss < *best)
-            {
-                screened = Some((whole.fit.rss, whole.setting));
+            let whole = serial
+                .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS)
+                .ok()?;
+            Some((whole.fit.rss, whole.setting))
+        };
+        let grid = grid_of(spec);
+        let width = problem.threads.max(1);
+        let mut points: Vec<Option<(f64, Setting)>> = Vec::new();
+        for chunk in grid.chunks(width) {
+            let done: Vec<Option<(f64, Setting)>> = std::thread::scope(|scope| {
+                let handles: Vec<_> = chunk
+                    .iter()
+                    .map(|values| scope.spawn(|| screen_point(values.clone())))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().ok().flatten())
+                    .collect()
+            });
+            points.extend(done);
+        }
+        let mut screened: Option<(f64, Setting)> = None;
+        for (rss, setting) in points.into_iter().flatten() {
+            if screened.as_ref().is_none_or(|(best, _)| rss < *best) {
+                screened = Some((rss, setting));
             }
         }
         let Some((screen_rss, start)) = screened else {
