@@ -1058,10 +1058,7 @@ fn diagnose(
         ..DiagnoseOptions::default()
     };
     let bar = stage_bar();
-    let progress = |msg: &str, fraction: f64| {
-        bar.set_message(msg.to_string());
-        bar.set_position((fraction * 100.0) as u64);
-    };
+    let progress = stage_progress(&bar);
     let result = commands::diagnose_to_disk(
         params,
         &source,
@@ -1112,6 +1109,14 @@ fn stage_bar() -> indicatif::ProgressBar {
     bar
 }
 
+/// What a diagnosis reports of its stages, shown on `bar`.
+fn stage_progress(bar: &indicatif::ProgressBar) -> impl Fn(&str, f64) + Sync + '_ {
+    move |msg: &str, fraction: f64| {
+        bar.set_message(msg.to_string());
+        bar.set_position((fraction * 100.0) as u64);
+    }
+}
+
 /// `piano diagnose` on a key-drive dataset.
 fn diagnose_key_drive(
     params: &piano_action::params::ActionParams,
@@ -1135,10 +1140,7 @@ fn diagnose_key_drive(
         ..KeyDiagnoseOptions::default()
     };
     let bar = stage_bar();
-    let progress = |msg: &str, fraction: f64| {
-        bar.set_message(msg.to_string());
-        bar.set_position((fraction * 100.0) as u64);
-    };
+    let progress = stage_progress(&bar);
     let result =
         commands::diagnose_key_drive_to_disk(params, dataset, &options, out, force, &progress);
     bar.finish_and_clear();
