@@ -31,8 +31,8 @@ fn options(ids: &[&str]) -> KeyDiagnoseOptions {
     }
 }
 
-/// A key that bends (its back arm on a spring of 3300 N·m/rad, close to a basswood key's
-/// estimated stiffness) is found and named among three candidates on one 0.15 s drop
+/// A key that bends (its back arm on a spring of 1000 N·m/rad, 3 times softer than a
+/// basswood key's estimated stiffness) is found and named among three candidates on one 0.15 s drop
 /// tracked at the key front and back and the hammer head and shank; the gap comes down to
 /// within 1.5 noise floors, and the bending's compliance within a factor 3.
 #[test]
@@ -58,7 +58,7 @@ fn a_bending_key_is_named() {
     assert_eq!(d.decision, "named", "{}", d.summary);
     assert_eq!(d.effects[0].id, "key_flex");
     let c = d.effects[0].params["compliance_rad_n_m"];
-    assert!((1e-4..9e-4).contains(&c), "compliance {c:e} (truth 3e-4)");
+    assert!((3.3e-4..3e-3).contains(&c), "compliance {c:e} (truth 1e-3)");
     assert!(
         d.after_rms_m < 1.5 * d.noise_floor_m,
         "gap {:.1} µm against a floor of {:.1}",
@@ -170,7 +170,10 @@ fn the_cli_diagnoses_a_key_drive_and_refuses_what_it_cannot_do() {
 /// effect at its visible strength and 5 negatives, two drops of 0.3 s tracked at the key
 /// front and back and the hammer head and shank; prints the outcomes and the rates the
 /// issue asks for, and checks them: the right effect (or an ambiguity holding it) in
-/// ≥ 80 %, a wrong confident name in ≤ 10 %, `none` in ≥ 80 % of the negatives.
+/// ≥ 80 %, a wrong confident name in ≤ 10 %, `none` in ≥ 80 % of the negatives; the gap
+/// after the check's catch 3 times lower, pooled over the datasets whose effect shows
+/// there (the two rise effects, `felt_hysteresis` and `knuckle_friction`, change the
+/// hammer's flight, not its catch).
 #[test]
 #[ignore]
 fn study_over_seeds() {
@@ -187,6 +190,9 @@ fn study_over_seeds() {
         )
         .collect();
     let (mut right, mut wrong, mut total, mut none_ok, mut negatives) = (0, 0, 0, 0, 0);
+    // The gap after the check's catch, before and after, of the datasets whose effect
+    // shows there (the baseline misses it by 3 noise floors or more): squared sums.
+    let (mut post_before, mut post_after, mut post_n) = (0.0, 0.0, 0);
     for effect in effects {
         for seed in 1..=seeds {
             let (ds, dir) = dataset(
@@ -205,8 +211,22 @@ fn study_over_seeds() {
                 .map(|e| e.id.clone())
                 .chain(d.ambiguous_with.iter().cloned())
                 .collect();
-            let post = piano_action::identify::key_report::post_check_gap(&d)
-                .map_or(String::new(), |(b, a)| format!(" post-check {:.1}x", b / a));
+            let post_gap = piano_action::identify::key_report::post_check_gap(&d);
+            let post = post_gap.map_or(String::new(), |(b, a)| {
+                format!(
+                    " post-check {:.0} -> {:.0} um ({:.1}x)",
+                    b * 1e6,
+                    a * 1e6,
+                    b / a
+                )
+            });
+            if let (Some((b, a)), Some(_)) = (post_gap, effect)
+                && b >= 3.0 * d.noise_floor_m
+            {
+                post_before += b * b;
+                post_after += a * a;
+                post_n += 1;
+            }
             let secs: f64 = d.timing.iter().map(|(_, t)| t).sum();
             eprintln!(
                 "{:22} seed {seed}: {:11} {:40} gap {:.0} -> {:.0} um{post} ({secs:.0} s)",
@@ -237,7 +257,16 @@ fn study_over_seeds() {
         "right (named or in the ambiguity): {right}/{total}; wrong confident name: \
          {wrong}/{total}; none on negatives: {none_ok}/{negatives}"
     );
+    let post_ratio = (post_before / post_after.max(1e-300)).sqrt();
+    eprintln!(
+        "gap after the check's catch, over the {post_n} datasets whose effect shows there: \
+         {post_ratio:.1}x lower"
+    );
     assert!(right * 5 >= total * 4, "right {right}/{total}");
+    assert!(
+        post_n == 0 || post_ratio >= 3.0,
+        "post-check {post_ratio:.1}x"
+    );
     assert!(wrong * 10 <= total, "wrong {wrong}/{total}");
     assert!(none_ok * 5 >= negatives * 4, "none {none_ok}/{negatives}");
 }

@@ -32,6 +32,8 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
 use mbs_identify::{Camera, Dataset, EffectSpec, Role};
@@ -211,13 +213,26 @@ pub struct KeyCandidate {
     pub params: BTreeMap<String, f64>,
     /// Their 95 % intervals.
     pub ci95: BTreeMap<String, [f64; 2]>,
-    /// Whether it passed every rule.
+    /// Whether it passed every rule (the held-out run is judged in BIC order until one
+    /// does: the ones ranked below are not kept, and say so).
     pub kept: bool,
     /// Whether it passed the BIC and effect-size rules (a rival an unseparated
     /// confusable effect must be told apart from).
     pub rival: bool,
     /// Why it was kept or dropped.
     pub why: String,
+    /// For a confusable rival of the chosen effect: the whitened BIC of the markers that
+    /// could tell them apart, in the chosen one's favour (they are told apart from
+    /// [`SEPARATION_BIC`] up).
+    pub separation_bic: Option<f64>,
+    /// Compute time spent screening it (core-seconds: the screening's points share the
+    /// cores).
+    pub screen_s: f64,
+    /// Compute time spent refitting it (core-seconds, on one core; 0 when dropped at
+    /// screening).
+    pub refit_s: f64,
+    /// The refit's accepted steps and residual evaluations.
+    pub refit_steps: [usize; 2],
 }
 
 /// Measured and modelled positions of one marker in one run, for the plots.
@@ -561,6 +576,25 @@ impl<'a> Problem<'a> {
         noise::whiten(&std, &starts, self.noise.rho)
     }
 
+    /// Whitened RSS and count of the fitted runs' observations of `markers`, from their
+    /// raw residuals `fit_res` (one per fitted run, in order).
+    fn markers_rss(&self, fit_res: &[Vec<f64>], markers: &[usize]) -> (f64, usize) {
+        let (mut rss, mut n) = (0.0, 0);
+        for (r, res) in self.fit_runs().zip(fit_res) {
+            let (std, starts): (Vec<f64>, Vec<bool>) = r
+                .obs
+                .iter()
+                .zip(res)
+                .filter(|(o, _)| markers.contains(&o.marker))
+                .map(|(o, e)| (e / self.noise.sigma, o.segment_start))
+                .unzip();
+            let w = noise::whiten(&std, &starts, self.noise.rho);
+            rss += w.iter().map(|x| x * x).sum::<f64>();
+            n += w.len();
+        }
+        (rss, n)
+    }
+
     fn fit_runs(&self) -> impl Iterator<Item = &Run> {
         self.runs.iter().filter(|r| r.role == Role::Fit)
     }
@@ -787,33 +821,45 @@ fn window_rms(r: &Run, res: &[f64], t0: f64, t1: f64, m: Option<usize>) -> f64 {
         .map(|(_, e)| *e))
 }
 
-/// Whether the dataset's markers can tell effect `a` from effect `b`: a flex or a
-/// compliant mount shows only in a marker on the part it lets move (the key's back arm,
-/// the hammer's head beside its shank, the back-check); two friction-like effects of the
-/// rise only in releases from different heights.
-pub fn separated(a: &str, b: &str, dataset: &Dataset, heights: &[f64]) -> bool {
-    let moving = |id: &str| matches!(id, "key_flex" | "shank_flex" | "backcheck_compliance");
-    let seen = |id: &str| {
-        dataset.markers.iter().any(|m| {
-            if id == "backcheck_compliance" {
-                m.body == "backcheck"
-            } else if id == "shank_flex" {
-                // Both sides of the head's root.
-                let side = |m: &mbs_identify::MarkerSpec| {
-                    marker_body(Some(id), &m.body, m.local_m).0 != m.body
-                };
-                side(m)
-                    && dataset
-                        .markers
-                        .iter()
-                        .any(|o| o.body == "hammer" && !side(o))
-            } else {
-                marker_body(Some(id), &m.body, m.local_m).0 != m.body
-            }
-        })
+/// Whether `id` lets a part of the action move that the file holds rigid (a flex or a
+/// compliant mount), so that only a marker on that part can show it.
+fn moving(id: &str) -> bool {
+    matches!(id, "key_flex" | "shank_flex" | "backcheck_compliance")
+}
+
+/// The tracked markers (indices into the dataset's) that could tell effect `a` from
+/// effect `b` when either lets a part move: a marker on the key's back arm (a bending
+/// key), on the back-check (a compliant wire), on the shank beside one on the head (a
+/// bending shank). Empty when no tracked marker can.
+pub fn separating_markers(a: &str, b: &str, dataset: &Dataset) -> Vec<usize> {
+    let moved = |id: &str, m: &mbs_identify::MarkerSpec| {
+        marker_body(Some(id), &m.body, m.local_m).0 != m.body
     };
+    let shows = |id: &str, m: &mbs_identify::MarkerSpec| match id {
+        "backcheck_compliance" => m.body == "backcheck",
+        // The shank beside the head: both sides of the head's root are tracked.
+        "shank_flex" => {
+            m.body == "hammer" && !moved(id, m) && dataset.markers.iter().any(|o| moved(id, o))
+        }
+        "key_flex" => moved(id, m),
+        _ => false,
+    };
+    (0..dataset.markers.len())
+        .filter(|&i| {
+            [a, b]
+                .iter()
+                .any(|id| moving(id) && shows(id, &dataset.markers[i]))
+        })
+        .collect()
+}
+
+/// Whether the dataset could tell effect `a` from effect `b` at all: a flex or a
+/// compliant mount shows only in a marker on the part it lets move (see
+/// [`separating_markers`]); two friction-like effects of the rise only in releases from
+/// different heights. Whether it does is the evidence's to say ([`SEPARATION_BIC`]).
+pub fn separated(a: &str, b: &str, dataset: &Dataset, heights: &[f64]) -> bool {
     if moving(a) || moving(b) {
-        (moving(a) && seen(a)) || (moving(b) && seen(b))
+        !separating_markers(a, b, dataset).is_empty()
     } else {
         let mut hs: Vec<f64> = heights.to_vec();
         hs.sort_by(f64::total_cmp);
@@ -821,6 +867,15 @@ pub fn separated(a: &str, b: &str, dataset: &Dataset, heights: &[f64]) -> bool {
         hs.len() >= 2
     }
 }
+
+/// How much better the best effect must explain the separating markers alone than a
+/// confusable rival does (whitened BIC on their observations, both fits having the same
+/// number of parameters) before the markers are taken to tell them apart [D]: the
+/// selection's own threshold (`identification.md` §4), "strong" evidence. A key-back
+/// marker is tracked but a bending key of 3e-4 rad/(N·m) moves it 20 µm from where a
+/// rigid key would, under the camera's noise: the structural test alone named the wrong
+/// one of two confusable effects (measured on a synthetic back-check, seed 2).
+pub const SEPARATION_BIC: f64 = 10.0;
 
 /// Points of the screening grid of a candidate's strength [D]: spread over its
 /// plausible range (log-spaced on a log scale), the other parameters at their typical
@@ -845,6 +900,28 @@ fn grid_of(spec: &EffectSpec) -> Vec<Vec<f64>> {
             values
         })
         .filter(|v| Some(v[0]) != p.null)
+        .collect()
+}
+
+/// The midpoints between point `i` of the screening `grid` and its neighbours, in the
+/// strength's own scale (log or linear).
+fn refine_grid(spec: &EffectSpec, grid: &[Vec<f64>], i: usize) -> Vec<Vec<f64>> {
+    let p = &spec.params[0];
+    let mid = |a: f64, b: f64| {
+        if p.log_scale {
+            (a * b).sqrt()
+        } else {
+            0.5 * (a + b)
+        }
+    };
+    [i.checked_sub(1), (i + 1 < grid.len()).then_some(i + 1)]
+        .into_iter()
+        .flatten()
+        .map(|j| {
+            let mut v = grid[i].clone();
+            v[0] = mid(grid[i][0], grid[j][0]);
+            v
+        })
         .collect()
 }
 
@@ -1018,64 +1095,114 @@ pub fn diagnose_key_drive(
         .fold(0.0, f64::max);
     lap("localisation", &mut since);
 
-    // C–D. Each candidate, refitted with the calibration free.
+    // C. Screening, every effect's grid at once on every core: at each point the rise is
+    // calibrated again with the effect in (an effect that acts in the rise would
+    // otherwise hide in the calibration), the back-check's values refitted briefly (the
+    // baseline has had the chance to hide the effect in them). Each point is serial; the
+    // points share the cores, and the results are taken in grid order whatever finished
+    // first.
     struct Tried {
         spec: &'static EffectSpec,
         fitted: Fitted,
+        /// The fitted runs' raw residuals (laid out as `fit_idx`).
+        fit_res: Vec<Vec<f64>>,
+        /// Every run's residuals and simulation, once the held-out run is judged.
         eval: Option<Vec<(Vec<f64>, Simulated)>>,
+        /// The rules it fails before the held-out run is judged.
+        fails: Vec<String>,
+        fall: f64,
         candidate: KeyCandidate,
     }
-    let mut tried: Vec<Tried> = Vec::new();
-    let mut tried_skipped: Vec<KeyCandidate> = Vec::new();
-    for (c, spec) in options.library.iter().enumerate() {
-        progress(&format!("trying {}", spec.id), (2.0 + c as f64) / steps);
-        // Screening: at each point of the grid the rise is calibrated again with the
-        // effect in (an effect that acts in the rise would otherwise hide in the
-        // calibration), the back-check's friction taken from the baseline; the point
-        // that fits the whole run best is refitted, if it beats the baseline.
-        // The points are independent: they run side by side (each fit's Jacobian is
-        // serial here), and the best is taken in grid order, whatever finished first.
-        let screen_point = |values: Vec<f64>| -> Option<(f64, Setting)> {
-            let start = Setting {
-                effect: Some(ActionEffect { spec, values }),
-                ..rise.setting.clone()
-            };
-            let serial = Problem {
-                threads: 1,
-                ..problem.shallow()
-            };
-            let recalibrated = serial
-                .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS)
-                .ok()?;
-            let mut s = recalibrated.setting;
-            for j in RISE_HELD {
-                s.cal[j] = baseline.setting.cal[j];
-            }
-            // What the rise cannot see, refitted briefly with the effect in: the baseline
-            // has had the chance to hide the effect in it.
-            let whole = serial
-                .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS)
-                .ok()?;
-            Some((whole.fit.rss, whole.setting))
+    let width = problem.threads.max(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(width)
+        .build()
+        .map_err(|e| PianoError::Simulation(format!("the diagnosis's threads: {e}")))?;
+    let serial = Problem {
+        threads: 1,
+        ..problem.shallow()
+    };
+    let screen_point =
+        |spec: &'static EffectSpec, values: &[f64]| -> (Option<(f64, Setting)>, f64) {
+            let clock = Instant::now();
+            let point = (|| {
+                let start = Setting {
+                    effect: Some(ActionEffect {
+                        spec,
+                        values: values.to_vec(),
+                    }),
+                    ..rise.setting.clone()
+                };
+                let recalibrated = serial
+                    .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS)
+                    .ok()?;
+                let mut s = recalibrated.setting;
+                for j in RISE_HELD {
+                    s.cal[j] = baseline.setting.cal[j];
+                }
+                let whole = serial
+                    .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS)
+                    .ok()?;
+                Some((whole.fit.rss, whole.setting))
+            })();
+            (point, clock.elapsed().as_secs_f64())
         };
-        let grid = grid_of(spec);
-        let width = problem.threads.max(1);
-        let mut points: Vec<Option<(f64, Setting)>> = Vec::new();
-        for chunk in grid.chunks(width) {
-            let done: Vec<Option<(f64, Setting)>> = std::thread::scope(|scope| {
-                let handles: Vec<_> = chunk
-                    .iter()
-                    .map(|values| scope.spawn(|| screen_point(values.clone())))
-                    .collect();
-                handles
+    let library = &options.library;
+    let screen_all = |jobs: &[(usize, Vec<f64>)]| -> Vec<(Option<(f64, Setting)>, f64)> {
+        pool.install(|| {
+            // One point a task, so that a core that finishes early takes the next.
+            jobs.par_iter()
+                .with_max_len(1)
+                .map(|(c, v)| screen_point(library[*c], v))
+                .collect()
+        })
+    };
+    progress(&format!("screening {} effects", library.len()), 2.0 / steps);
+    let grids: Vec<Vec<Vec<f64>>> = library.iter().map(|s| grid_of(s)).collect();
+    let jobs: Vec<(usize, Vec<f64>)> = grids
+        .iter()
+        .enumerate()
+        .flat_map(|(c, g)| g.iter().map(move |v| (c, v.clone())))
+        .collect();
+    let mut points: Vec<Vec<Option<(f64, Setting)>>> = vec![Vec::new(); library.len()];
+    let mut screen_s = vec![0.0; library.len()];
+    for ((c, _), (p, secs)) in jobs.iter().zip(screen_all(&jobs)) {
+        points[*c].push(p);
+        screen_s[*c] += secs;
+    }
+    // The grid is coarse (a factor 4 on a log scale) and the fit is not convex in the
+    // strength (the checked hammer slips or holds): the two midpoints beside each
+    // effect's best point are screened as well, so the refit starts in the right basin
+    // (a bending key of 1e-3 refitted from 2.5e-3 stopped at 2e-3 with twice the noise
+    // floor's gap, measured).
+    progress("screening: the best points refined", 2.5 / steps);
+    let refine: Vec<(usize, Vec<f64>)> = (0..library.len())
+        .filter_map(|c| {
+            let i = (0..points[c].len())
+                .filter_map(|i| points[c][i].as_ref().map(|(rss, _)| (i, *rss)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))?
+                .0;
+            Some(
+                refine_grid(library[c], &grids[c], i)
                     .into_iter()
-                    .map(|h| h.join().ok().flatten())
-                    .collect()
-            });
-            points.extend(done);
-        }
+                    .map(move |v| (c, v)),
+            )
+        })
+        .flatten()
+        .collect();
+    for ((c, _), (p, secs)) in refine.iter().zip(screen_all(&refine)) {
+        points[*c].push(p);
+        screen_s[*c] += secs;
+    }
+    lap("candidates: screening", &mut since);
+
+    // D. The effects whose best point beats the baseline, refitted with the effect's
+    // parameters and the back-check's values free, side by side.
+    let mut tried_skipped: Vec<KeyCandidate> = Vec::new();
+    let mut starts: Vec<(usize, Setting)> = Vec::new();
+    for (c, spec) in library.iter().enumerate() {
         let mut screened: Option<(f64, Setting)> = None;
-        for (rss, setting) in points.into_iter().flatten() {
+        for (rss, setting) in std::mem::take(&mut points[c]).into_iter().flatten() {
             if screened.as_ref().is_none_or(|(best, _)| rss < *best) {
                 screened = Some((rss, setting));
             }
@@ -1083,28 +1210,69 @@ pub fn diagnose_key_drive(
         let Some((screen_rss, start)) = screened else {
             continue;
         };
-        if screen_rss >= baseline.fit.rss {
-            let n = baseline.fit.residuals.len() as f64;
-            tried_skipped.push(KeyCandidate {
-                id: spec.id.to_string(),
-                delta_bic: n * (screen_rss / baseline.fit.rss).ln(),
-                fit_rms_m: f64::NAN,
-                heldout_rms_m: None,
-                flagged_rms_m: f64::NAN,
-                params: BTreeMap::new(),
-                ci95: BTreeMap::new(),
-                kept: false,
-                rival: false,
-                why: format!(
-                    "dropped at screening: no strength over its plausible range improves on \
-                     the baseline (best whitened RSS {:+.0})",
-                    screen_rss - baseline.fit.rss
-                ),
-            });
+        if screen_rss < baseline.fit.rss {
+            starts.push((c, start));
             continue;
         }
-        let best = problem.fit(&start, Stage::Candidate).ok();
-        let Some(fitted) = best else { continue };
+        let n = baseline.fit.residuals.len() as f64;
+        tried_skipped.push(KeyCandidate {
+            id: spec.id.to_string(),
+            delta_bic: n * (screen_rss / baseline.fit.rss).ln(),
+            fit_rms_m: f64::NAN,
+            heldout_rms_m: None,
+            flagged_rms_m: f64::NAN,
+            params: BTreeMap::new(),
+            ci95: BTreeMap::new(),
+            kept: false,
+            rival: false,
+            separation_bic: None,
+            screen_s: screen_s[c],
+            refit_s: 0.0,
+            refit_steps: [0, 0],
+            why: format!(
+                "dropped at screening: no strength over its plausible range improves on \
+                 the baseline (best whitened RSS {:+.0})",
+                screen_rss - baseline.fit.rss
+            ),
+        });
+    }
+    progress(
+        &format!("refitting {} effects", starts.len()),
+        (2.0 + 0.5 * library.len() as f64) / steps,
+    );
+    type Refit = Option<(Fitted, Vec<Vec<f64>>)>;
+    let refits: Vec<(Result<Refit>, f64)> = pool.install(|| {
+        starts
+            .par_iter()
+            .with_max_len(1)
+            .map(|(_, start)| {
+                let clock = Instant::now();
+                let refit = (|| -> Result<Refit> {
+                    let Ok(fitted) = serial.fit(start, Stage::Candidate) else {
+                        return Ok(None);
+                    };
+                    let fit_res = fit_idx
+                        .iter()
+                        .zip(&fitted.setting.runs)
+                        .map(|(&i, &(h, off))| {
+                            let r = &serial.runs[i];
+                            serial
+                                .simulate(&fitted.setting, r, h, off)
+                                .map(|s| raw(r, &s.predicted))
+                        })
+                        .collect::<Result<Vec<_>>>()?;
+                    Ok(Some((fitted, fit_res)))
+                })();
+                (refit, clock.elapsed().as_secs_f64())
+            })
+            .collect()
+    });
+    let mut tried: Vec<Tried> = Vec::new();
+    for ((c, _), (refit, refit_s)) in starts.iter().zip(refits) {
+        let spec = library[*c];
+        let Some((fitted, fit_res)) = refit? else {
+            continue;
+        };
         let values = fitted
             .setting
             .effect
@@ -1112,33 +1280,17 @@ pub fn diagnose_key_drive(
             .map(|e| e.values.clone())
             .unwrap_or_default();
         let delta_bic = fitted.bic - baseline.bic;
-        let fit_eval: Vec<f64> = fit_idx
-            .iter()
-            .zip(&fitted.setting.runs)
-            .map(|(&i, &(h, off))| {
-                let r = &problem.runs[i];
-                problem
-                    .simulate(&fitted.setting, r, h, off)
-                    .map(|s| raw(r, &s.predicted))
-            })
-            .collect::<Result<Vec<_>>>()?
-            .concat();
-        let fit_rms = rms(fit_eval);
+        let fit_rms = rms(fit_res.iter().flatten().copied());
         // The flagged phase: the first fitted run's residuals.
-        let first = {
-            let (h, off) = fitted.setting.runs[0];
-            let sim = problem.simulate(&fitted.setting, r0, h, off)?;
-            raw(r0, &sim.predicted)
-        };
-        let c_flagged = window_rms(r0, &first, flag_phase.from_s, flag_phase.to_s, None);
+        let c_flagged = window_rms(r0, &fit_res[0], flag_phase.from_s, flag_phase.to_s, None);
         let fall = 1.0 - c_flagged / flagged_before.max(1e-300);
         let rival = delta_bic <= DELTA_BIC_MAX && fall >= EFFECT_SIZE_MIN;
-        let mut why = Vec::new();
+        let mut fails = Vec::new();
         if delta_bic > DELTA_BIC_MAX {
-            why.push(format!("ΔBIC {delta_bic:.1} > {DELTA_BIC_MAX}"));
+            fails.push(format!("ΔBIC {delta_bic:.1} > {DELTA_BIC_MAX}"));
         }
         if fall < EFFECT_SIZE_MIN {
-            why.push(format!(
+            fails.push(format!(
                 "flagged phase only {:.0} % lower (needs {:.0} %)",
                 100.0 * fall,
                 100.0 * EFFECT_SIZE_MIN
@@ -1156,56 +1308,24 @@ pub fn diagnose_key_drive(
         let rel = sd / (strength - null).abs().max(1e-300);
         for (p, v) in spec.params.iter().zip(&values) {
             if !(p.range[0]..=p.range[1]).contains(v) {
-                why.push(format!(
+                fails.push(format!(
                     "{} = {v:.3e} {} outside the plausible [{:.1e}, {:.1e}]",
                     p.name, p.unit, p.range[0], p.range[1]
                 ));
             }
         }
         if rel.is_nan() || rel > IDENTIFIABLE_REL_SD {
-            why.push(if rel < 1e3 {
+            fails.push(if rel < 1e3 {
                 format!("strength not identified (SD {rel:.2} of its distance from the null)")
             } else {
                 "strength not identified (the data do not constrain it)".to_string()
             });
         }
-        // The held-out run only for a rival (it costs a refit per run).
-        let mut eval = None;
-        let mut heldout_rms = None;
-        if rival {
-            let e = evaluate(&fitted.setting)?;
-            heldout_rms = total_rms(&e, &held_idx);
-            if let (Some(after), Some(before)) = (heldout_rms, base_held_rms) {
-                let growth = after / before.max(1e-300) - 1.0;
-                if growth > HELDOUT_WORSEN_MAX {
-                    why.push(format!(
-                        "held-out run {:.0} % worse (at most {:.0} %)",
-                        100.0 * growth,
-                        100.0 * HELDOUT_WORSEN_MAX
-                    ));
-                }
-            }
-            eval = Some(e);
-        }
-        let kept = why.is_empty();
-        let why = if kept {
-            format!(
-                "kept: ΔBIC {delta_bic:.0}, flagged phase {:.0} % lower{}",
-                100.0 * fall,
-                match (heldout_rms, base_held_rms) {
-                    (Some(a), Some(b)) =>
-                        format!(", held-out {:.0} % lower", 100.0 * (1.0 - a / b)),
-                    _ => String::new(),
-                }
-            )
-        } else {
-            format!("dropped: {}", why.join("; "))
-        };
         let candidate = KeyCandidate {
             id: spec.id.to_string(),
             delta_bic,
             fit_rms_m: fit_rms,
-            heldout_rms_m: heldout_rms,
+            heldout_rms_m: None,
             flagged_rms_m: c_flagged,
             params: spec
                 .params
@@ -1219,18 +1339,74 @@ pub fn diagnose_key_drive(
                 .enumerate()
                 .map(|(j, p)| (p.name.to_string(), fitted.fit.ci95[RISE_HELD.len() + j]))
                 .collect(),
-            kept,
+            kept: false,
             rival,
-            why,
+            why: String::new(),
+            separation_bic: None,
+            screen_s: screen_s[*c],
+            refit_s,
+            refit_steps: [fitted.fit.iterations, fitted.fit.evaluations],
         };
         tried.push(Tried {
             spec,
             fitted,
-            eval,
+            fit_res,
+            eval: None,
+            fails,
+            fall,
             candidate,
         });
     }
-    lap("candidates", &mut since);
+    // The held-out run (a refit of its release and clock per run) is judged in BIC
+    // order, until an effect passes every rule: the ones ranked below it cannot be
+    // chosen, and their held-out run is left unjudged.
+    let mut order: Vec<usize> = (0..tried.len()).collect();
+    order.sort_by(|&a, &b| tried[a].fitted.bic.total_cmp(&tried[b].fitted.bic));
+    let mut chosen_yet = false;
+    for i in order {
+        let t = &mut tried[i];
+        if !t.fails.is_empty() {
+            t.candidate.why = format!("dropped: {}", t.fails.join("; "));
+            continue;
+        }
+        if chosen_yet {
+            t.candidate.why = "passes the rules judged; its held-out run was not judged (a \
+                better-ranked effect passes every rule)"
+                .to_string();
+            continue;
+        }
+        let e = evaluate(&t.fitted.setting)?;
+        let heldout_rms = total_rms(&e, &held_idx);
+        t.candidate.heldout_rms_m = heldout_rms;
+        if let (Some(after), Some(before)) = (heldout_rms, base_held_rms) {
+            let growth = after / before.max(1e-300) - 1.0;
+            if growth > HELDOUT_WORSEN_MAX {
+                t.fails.push(format!(
+                    "held-out run {:.0} % worse (at most {:.0} %)",
+                    100.0 * growth,
+                    100.0 * HELDOUT_WORSEN_MAX
+                ));
+            }
+        }
+        t.eval = Some(e);
+        t.candidate.kept = t.fails.is_empty();
+        chosen_yet = t.candidate.kept;
+        t.candidate.why = if t.candidate.kept {
+            format!(
+                "kept: ΔBIC {:.0}, flagged phase {:.0} % lower{}",
+                t.candidate.delta_bic,
+                100.0 * t.fall,
+                match (heldout_rms, base_held_rms) {
+                    (Some(a), Some(b)) =>
+                        format!(", held-out {:.0} % lower", 100.0 * (1.0 - a / b)),
+                    _ => String::new(),
+                }
+            )
+        } else {
+            format!("dropped: {}", t.fails.join("; "))
+        };
+    }
+    lap("candidates: refits and held-out", &mut since);
     progress("writing the diagnosis", 1.0);
 
     // E. The decision: the lowest BIC of the kept; rivals within the BIC margin, or
@@ -1242,6 +1418,8 @@ pub fn diagnose_key_drive(
     kept.sort_by(|&a, &b| tried[a].fitted.bic.total_cmp(&tried[b].fitted.bic));
     let best = kept.first().copied();
     let mut ambiguous_with = Vec::new();
+    // (rival, whitened BIC of the separating markers in the best's favour)
+    let mut separations: Vec<(String, f64)> = Vec::new();
     if let Some(b) = best {
         for (i, t) in tried.iter().enumerate() {
             if i == b || !t.candidate.rival {
@@ -1254,9 +1432,40 @@ pub fn diagnose_key_drive(
             let close = t.fitted.bic - tried[b].fitted.bic < AMBIGUITY_BIC;
             let confusable = tried[b].spec.confusable_with.contains(&t.spec.id)
                 || t.spec.confusable_with.contains(&tried[b].spec.id);
-            if close || (confusable && !separated(tried[b].spec.id, t.spec.id, dataset, &heights)) {
+            let (a_id, t_id) = (tried[b].spec.id, t.spec.id);
+            let told_apart = if !confusable {
+                true
+            } else if !separated(a_id, t_id, dataset, &heights) {
+                false
+            } else if moving(a_id) || moving(t_id) {
+                // The markers could tell them apart: do they? The best must explain
+                // them clearly better than the rival.
+                let markers = separating_markers(a_id, t_id, dataset);
+                let (rss_b, n) = problem.markers_rss(&tried[b].fit_res, &markers);
+                let (rss_t, _) = problem.markers_rss(&t.fit_res, &markers);
+                let evidence = n as f64 * (rss_t / rss_b.max(1e-300)).ln();
+                separations.push((t_id.to_string(), evidence));
+                evidence >= SEPARATION_BIC
+            } else {
+                true
+            };
+            if close || !told_apart {
                 ambiguous_with.push(t.spec.id.to_string());
             }
+        }
+    }
+    for (id, e) in &separations {
+        if let Some(t) = tried.iter_mut().find(|t| t.spec.id == id) {
+            t.candidate.separation_bic = Some(*e);
+            t.candidate.why.push_str(&format!(
+                "; the markers that could tell it from the chosen effect favour that one by \
+                 a whitened BIC of {e:.1} ({})",
+                if *e >= SEPARATION_BIC {
+                    "told apart"
+                } else {
+                    "not enough to tell them apart"
+                }
+            ));
         }
     }
     let (decision, summary) = match best {
@@ -1273,9 +1482,22 @@ pub fn diagnose_key_drive(
         Some(b) => (
             "ambiguous".to_string(),
             format!(
-                "{} or {}: the data cannot separate them",
+                "{} or {}: the data cannot separate them{}",
                 tried[b].spec.id,
-                ambiguous_with.join(" or ")
+                ambiguous_with.join(" or "),
+                separations
+                    .iter()
+                    .filter(|(_, e)| *e < SEPARATION_BIC)
+                    .map(|(id, e)| format!(
+                        "; against {id} the markers that could ({}) favour it by a whitened \
+                         BIC of only {e:.1} (needs {SEPARATION_BIC})",
+                        separating_markers(tried[b].spec.id, id, dataset)
+                            .iter()
+                            .map(|&m| dataset.markers[m].name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ))
+                    .collect::<String>()
             ),
         ),
         None if base_worst_floors <= EXPLAINED_FLOORS => (
@@ -1297,9 +1519,20 @@ pub fn diagnose_key_drive(
         ),
     };
     let chosen = best.filter(|_| decision == "named" || decision == "ambiguous");
-    let separating = best
-        .filter(|_| decision == "ambiguous")
-        .map(|b| tried[b].spec.discriminating_experiment.to_string());
+    let separating = best.filter(|_| decision == "ambiguous").map(|b| {
+        let weak = separations.iter().any(|(_, e)| *e < SEPARATION_BIC);
+        format!(
+            "{}{}",
+            tried[b].spec.discriminating_experiment,
+            if weak {
+                " (such a marker is tracked here, but the effect moves it too little \
+                     against the camera's noise: track it more finely, or load the key \
+                     more)"
+            } else {
+                ""
+            }
+        )
+    });
     let after_eval: &[(Vec<f64>, Simulated)] = match chosen.and_then(|b| tried[b].eval.as_ref()) {
         Some(e) => e,
         None => &base_eval,
@@ -1616,6 +1849,31 @@ mod tests {
             drive: Some("key_front".into()),
             runs: Vec::new(),
         }
+    }
+
+    #[test]
+    fn the_separating_markers_are_those_on_the_freed_part() {
+        let front = ("key_front", "key", [-0.2, 0.01]);
+        let back = ("key_back", "key", [0.225, 0.0]);
+        let head = ("hammer_head", "hammer", [0.132, 0.0356]);
+        let shank = ("hammer_shank", "hammer", [0.066, 0.0178]);
+        let four = dataset_with(&[front, back, head, shank]);
+        assert_eq!(
+            separating_markers("key_flex", "backcheck_compliance", &four),
+            vec![1]
+        );
+        assert_eq!(
+            separating_markers("shank_flex", "backcheck_compliance", &four),
+            vec![3]
+        );
+        assert_eq!(
+            separating_markers("key_flex", "shank_flex", &four),
+            vec![1, 3]
+        );
+        // The shank alone, without the head, shows no bending.
+        let no_head = dataset_with(&[front, shank]);
+        assert!(separating_markers("shank_flex", "key_flex", &no_head).is_empty());
+        assert!(separating_markers("felt_hysteresis", "knuckle_friction", &four).is_empty());
     }
 
     #[test]

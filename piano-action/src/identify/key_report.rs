@@ -174,7 +174,7 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             um(p.after_rms_m)
         );
     }
-    s.push_str("\n## Candidates\n\n| effect | ΔBIC (whitened) | fit (µm) | held-out (µm) | parameters | kept | why |\n|---|---|---|---|---|---|---|\n");
+    s.push_str("\n## Candidates\n\n| effect | ΔBIC (whitened) | fit (µm) | held-out (µm) | parameters | kept | why | compute (core-s: screening + refit) |\n|---|---|---|---|---|---|---|---|\n");
     for c in &d.candidates {
         let params: Vec<String> = c
             .params
@@ -183,14 +183,16 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "| `{}` | {:.1} | {} | {} | {} | {} | {} |",
+            "| `{}` | {:.1} | {} | {} | {} | {} | {} | {:.1} + {:.1} |",
             c.id,
             c.delta_bic,
             um(c.fit_rms_m),
             opt_um(c.heldout_rms_m),
             params.join(", "),
             if c.kept { "yes" } else { "no" },
-            c.why
+            c.why,
+            c.screen_s,
+            c.refit_s
         );
     }
     s.push_str("\n## Calibrated\n\n");
@@ -386,7 +388,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             um(p.after_rms_m)
         );
     }
-    s.push_str("</tbody></table>\n<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th></tr></thead><tbody>\n");
+    s.push_str("</tbody></table>\n<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th><th>compute (core-s: screening + refit)</th></tr></thead><tbody>\n");
     for c in &d.candidates {
         let params: Vec<String> = c
             .params
@@ -395,14 +397,16 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             .collect();
         let _ = writeln!(
             s,
-            "<tr><td><code>{}</code></td><td class=\"num\">{:.1}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td><code>{}</code></td><td class=\"num\">{:.1}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{:.1} + {:.1}</td></tr>",
             escape(&c.id),
             c.delta_bic,
             um(c.fit_rms_m),
             opt_um(c.heldout_rms_m),
             escape(&params.join(", ")),
             if c.kept { "yes" } else { "no" },
-            escape(&c.why)
+            escape(&c.why),
+            c.screen_s,
+            c.refit_s
         );
     }
     s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n");
