@@ -119,6 +119,16 @@ pub struct LmOptions {
     /// Threads on which the Jacobian's evaluations run (default 2; 1 = serial, 0 taken as
     /// 1). The result does not depend on it.
     pub threads: usize,
+    /// Whether the fit returns the covariance (default true). Without it a fit that stops
+    /// on its step limit or on a small step returns without evaluating the Jacobian there
+    /// (one Jacobian fewer; the values are the same; `covariance` is `None`, `sd` and
+    /// `ci95` NaN): for fits whose optimum alone is wanted, e.g. a screening.
+    #[serde(default = "default_covariance")]
+    pub covariance: bool,
+}
+
+fn default_covariance() -> bool {
+    true
 }
 
 impl Default for LmOptions {
@@ -130,6 +140,7 @@ impl Default for LmOptions {
             fd_relative_step: 1e-4,
             central: false,
             threads: 2,
+            covariance: true,
         }
     }
 }
@@ -290,24 +301,29 @@ where
     };
     let mut at = Point::new(x, z, r);
     if axes.is_empty() {
-        return Ok(problem.finish(at, &[], 0, Stop::Stationary));
+        return Ok(problem.finish(at, Some(&[]), 0, Stop::Stationary));
     }
 
     let mut damping = Damping::new(axes.len());
     let mut accepted = 0;
     let mut pending: Option<Stop> = None;
     loop {
+        // Without a covariance wanted, a fit that stops here needs no Jacobian.
+        if !options.covariance && (pending.is_some() || accepted >= options.max_iterations) {
+            let stop = pending.unwrap_or(Stop::MaxIterations);
+            return Ok(problem.finish(at, None, accepted, stop));
+        }
         // The Jacobian at every accepted point: the next step's, or the covariance's.
         let jac = problem.jacobian(&at)?;
         if let Some(stop) = pending {
-            return Ok(problem.finish(at, &jac, accepted, stop));
+            return Ok(problem.finish(at, Some(&jac), accepted, stop));
         }
         let model = Model::new(&jac, &at, &axes, &mut damping);
         if let Some(stop) = model.converged(options.cost_tolerance * at.rss) {
-            return Ok(problem.finish(at, &jac, accepted, stop));
+            return Ok(problem.finish(at, Some(&jac), accepted, stop));
         }
         if accepted >= options.max_iterations {
-            return Ok(problem.finish(at, &jac, accepted, Stop::MaxIterations));
+            return Ok(problem.finish(at, Some(&jac), accepted, Stop::MaxIterations));
         }
         match problem.trials(&at, &model, &mut damping)? {
             Trial::Accepted { next, small } => {
@@ -315,7 +331,7 @@ where
                 accepted += 1;
                 pending = small.then_some(Stop::CostTolerance);
             }
-            Trial::Stop(stop) => return Ok(problem.finish(at, &jac, accepted, stop)),
+            Trial::Stop(stop) => return Ok(problem.finish(at, Some(&jac), accepted, stop)),
         }
     }
 }
@@ -759,7 +775,7 @@ where
     }
 
     /// The fit at `at`, with its Jacobian `jac` (empty when there are no parameters).
-    fn finish(&self, at: Point, jac: &[Vec<f64>], iterations: usize, stop: Stop) -> LmFit {
+    fn finish(&self, at: Point, jac: Option<&[Vec<f64>]>, iterations: usize, stop: Stop) -> LmFit {
         let Point {
             x: values,
             z,
@@ -767,7 +783,7 @@ where
             rss,
         } = at;
         let k = values.len();
-        let covariance_u = covariance_internal(jac, rss, self.n);
+        let covariance_u = jac.and_then(|jac| covariance_internal(jac, rss, self.n));
         // Delta method: x = x(z), z = typical·u, so dx/du = typical·dx/dz.
         let grad: Vec<f64> = (0..k)
             .map(|i| self.axes[i].typical * self.axes[i].dx_dz(values[i]))

@@ -369,3 +369,38 @@ fn the_thread_count_does_not_change_the_result() {
         }
     }
 }
+
+/// A fit without a covariance stops where the one with it does, with the same values, one
+/// Jacobian (two evaluations here) cheaper at its step limit, and says it has none.
+#[test]
+fn a_fit_without_covariance_skips_only_the_last_jacobian() {
+    let data = decay_data(7);
+    let mut limited = 0;
+    for max_iterations in [1, 2] {
+        let with = fit_decay(
+            &data,
+            &LmOptions {
+                max_iterations,
+                ..LmOptions::default()
+            },
+        );
+        let without = fit_decay(
+            &data,
+            &LmOptions {
+                max_iterations,
+                covariance: false,
+                ..LmOptions::default()
+            },
+        );
+        assert_eq!(with.values, without.values);
+        assert_eq!(with.rss, without.rss);
+        assert_eq!(with.iterations, without.iterations);
+        if with.stop == Stop::MaxIterations {
+            assert_eq!(without.evaluations + 2, with.evaluations);
+            limited += 1;
+        }
+        assert!(with.covariance.is_some());
+        assert!(without.covariance.is_none() && without.sd.iter().all(|v| v.is_nan()));
+    }
+    assert!(limited > 0, "no fit reached its step limit");
+}

@@ -138,7 +138,8 @@ pub const SCREEN_ITERATIONS: usize = 4;
 pub struct KeyDiagnoseOptions {
     /// The effects tried (by default the whole action family).
     pub library: Vec<&'static EffectSpec>,
-    /// Threads for the fits' Jacobians.
+    /// Threads: the baseline fits' Jacobians, the screening's points and the refits share
+    /// them (by default one per core).
     pub threads: usize,
     /// The model.
     pub kind: ModelKind,
@@ -148,7 +149,7 @@ impl Default for KeyDiagnoseOptions {
     fn default() -> Self {
         Self {
             library: ACTION_EFFECTS.iter().collect(),
-            threads: 2,
+            threads: std::thread::available_parallelism().map_or(2, |n| n.get()),
             kind: ModelKind::Double,
         }
     }
@@ -704,11 +705,18 @@ impl<'a> Problem<'a> {
     /// Output-error fit of `stage` from `start` on the fitted runs (on the rise, their
     /// frames before `self.rise_end`).
     fn fit(&self, start: &Setting, stage: Stage) -> Result<Fitted> {
-        self.fit_limited(start, stage, MAX_ITERATIONS)
+        self.fit_limited(start, stage, MAX_ITERATIONS, true)
     }
 
-    /// [`Problem::fit`] with at most `iterations` accepted steps.
-    fn fit_limited(&self, start: &Setting, stage: Stage, iterations: usize) -> Result<Fitted> {
+    /// [`Problem::fit`] with at most `iterations` accepted steps, with the covariance or
+    /// (a screening's fits, whose optimum alone is wanted) without it.
+    fn fit_limited(
+        &self,
+        start: &Setting,
+        stage: Stage,
+        iterations: usize,
+        covariance: bool,
+    ) -> Result<Fitted> {
         let horizon = if stage == Stage::Rise {
             self.rise_end
         } else {
@@ -728,6 +736,7 @@ impl<'a> Problem<'a> {
         };
         let options = LmOptions {
             max_iterations: iterations,
+            covariance,
             ..self.lm_options()
         };
         let fit = levenberg_marquardt(&free, residuals, &options)
@@ -759,7 +768,12 @@ impl<'a> Problem<'a> {
             let sim = self.simulate(s, r, x[0], x[1]).map_err(|e| e.to_string())?;
             Ok(self.whitened(r, &sim.predicted))
         };
-        let fit = levenberg_marquardt(&free, residuals, &self.lm_options())
+        // Its values alone are wanted.
+        let options = LmOptions {
+            covariance: false,
+            ..self.lm_options()
+        };
+        let fit = levenberg_marquardt(&free, residuals, &options)
             .map_err(|e| PianoError::Simulation(format!("held-out fit: {e}")))?;
         let sim = self.simulate(s, r, fit.values[0], fit.values[1])?;
         Ok((raw(r, &sim.predicted), sim))
@@ -1134,14 +1148,14 @@ pub fn diagnose_key_drive(
                     ..rise.setting.clone()
                 };
                 let recalibrated = serial
-                    .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS)
+                    .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS, false)
                     .ok()?;
                 let mut s = recalibrated.setting;
                 for j in RISE_HELD {
                     s.cal[j] = baseline.setting.cal[j];
                 }
                 let whole = serial
-                    .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS)
+                    .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS, false)
                     .ok()?;
                 Some((whole.fit.rss, whole.setting))
             })();
