@@ -39,6 +39,9 @@ pub struct Stats {
     pub steps: usize,
     /// Rejected steps (error too large, Newton failure or non-finite stage).
     pub rejected: usize,
+    /// Of those, the ones rejected because Newton failed (or a stage was not finite) even
+    /// with a fresh Jacobian; the rest failed the error estimate.
+    pub rejected_newton: usize,
     /// Evaluations of the derivative (including those for finite-difference Jacobians).
     pub derivative_evals: usize,
     /// Jacobian evaluations (analytic or by finite differences).

@@ -453,6 +453,7 @@ impl Stepper for TrBdf2 {
                     return Err(IntegratorError::NewtonFailure { t: self.t, h });
                 }
                 st.rejected += 1;
+                st.rejected_newton += 1;
                 rejected_once = true;
                 self.h = 0.25 * h;
                 continue;
