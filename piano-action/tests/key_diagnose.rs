@@ -31,30 +31,41 @@ fn options(ids: &[&str]) -> KeyDiagnoseOptions {
     }
 }
 
+/// The CI tier's diagnosis: one 0.15 s drop from rest (seed `seed`, effect `effect` at
+/// its visible strength), four markers, three candidates; the dataset removed after.
+fn short_drop_diagnosis(
+    tag: &str,
+    seed: u64,
+    effect: Option<&str>,
+) -> piano_action::identify::key_diagnose::KeyDriveDiagnosis {
+    let (ds, dir) = dataset(
+        tag,
+        &KeyDriveOptions {
+            seed,
+            release_heights_m: vec![0.0],
+            duration_s: 0.15,
+            effect: effect.map(|e| ActionEffect::parse(e).expect("parses")),
+            ..KeyDriveOptions::default()
+        },
+    );
+    let d = diagnose_key_drive(
+        &ActionParams::reference(),
+        &ds,
+        &options(&["key_flex", "knuckle_friction", "felt_hysteresis"]),
+        &|_, _| {},
+    )
+    .expect("diagnoses");
+    std::fs::remove_dir_all(&dir).ok();
+    d
+}
+
 /// A key that bends (its back arm on a spring of 1000 N·m/rad, 3 times softer than a
 /// basswood key's estimated stiffness) is found and named among three candidates on one 0.15 s drop
 /// tracked at the key front and back and the hammer head and shank; the gap comes down to
 /// within 1.5 noise floors, and the bending's compliance within a factor 3.
 #[test]
 fn a_bending_key_is_named() {
-    let (ds, dir) = dataset(
-        "flex",
-        &KeyDriveOptions {
-            seed: 1,
-            release_heights_m: vec![0.0],
-            duration_s: 0.15,
-            effect: Some(ActionEffect::parse("key_flex").expect("parses")),
-            ..KeyDriveOptions::default()
-        },
-    );
-    let params = ActionParams::reference();
-    let d = diagnose_key_drive(
-        &params,
-        &ds,
-        &options(&["key_flex", "knuckle_friction", "felt_hysteresis"]),
-        &|_, _| {},
-    )
-    .expect("diagnoses");
+    let d = short_drop_diagnosis("flex", 1, Some("key_flex"));
     assert_eq!(d.decision, "named", "{}", d.summary);
     assert_eq!(d.effects[0].id, "key_flex");
     let c = d.effects[0].params["compliance_rad_n_m"];
@@ -66,33 +77,15 @@ fn a_bending_key_is_named() {
         d.noise_floor_m * 1e6
     );
     assert!(d.before_rms_m > 1.3 * d.after_rms_m);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The file's own action, camera noise and nuisance only: nothing is added.
 #[test]
 fn nothing_is_added_to_an_action_without_a_hidden_effect() {
-    let (ds, dir) = dataset(
-        "none",
-        &KeyDriveOptions {
-            seed: 2,
-            release_heights_m: vec![0.0],
-            duration_s: 0.15,
-            ..KeyDriveOptions::default()
-        },
-    );
-    let params = ActionParams::reference();
-    let d = diagnose_key_drive(
-        &params,
-        &ds,
-        &options(&["key_flex", "knuckle_friction", "felt_hysteresis"]),
-        &|_, _| {},
-    )
-    .expect("diagnoses");
+    let d = short_drop_diagnosis("none", 2, None);
     assert_eq!(d.decision, "none", "{}", d.summary);
     assert!(d.effects.is_empty());
     assert!(d.before_rms_m < 1.5 * d.noise_floor_m);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `piano diagnose` reads a key-drive dataset, writes its three pages (the replay in the
