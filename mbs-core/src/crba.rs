@@ -3,11 +3,12 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::data::Data;
+use crate::data::{Data, add_to_parent};
 use crate::error::{CoreError, Result, check_input};
-use crate::model::Model;
+use crate::kinematics::joint_transforms;
+use crate::model::{BodyModel, JointType, Model};
 use crate::rnea::{Output, check_forces, rnea_pass};
-use crate::spatial::Force;
+use crate::spatial::{Force, Inertia};
 
 /// The joint-space mass matrix `M(q)` (full and symmetric), written to
 /// `data.mass_matrix()` and returned.
@@ -18,42 +19,70 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> Result<&'d DMat
     Ok(&data.mass_matrix)
 }
 
+/// The CRBA passes: joint transforms and poses for `q`, composite inertias, then the mass
+/// matrix column by column.
 pub(crate) fn crba_pass(model: &Model, data: &mut Data, q: &[f64]) {
-    let bodies = &model.bodies;
+    joint_transforms(model, data, q);
+    let bodies = model.bodies.as_slice();
     let nb = bodies.len();
+    // Per-body arrays cut to the body count: indexing by the loop counter needs no check.
+    let x_up = &data.x_up[..nb];
+    let ic = &mut data.ic[..nb];
+    ic[0] = Inertia::ZERO;
     for i in 1..nb {
-        let b = &bodies[i];
-        let x = b.joint_transform(q[b.idx_v]);
-        data.x_up[i] = x;
-        data.x_world[i] = data.x_world[b.parent].compose(&x);
-        data.ic[i] = b.inertia;
+        ic[i] = bodies[i].inertia;
     }
-    // IC_λ += Xᵀ IC_i X
+    // IC_λ += Xᵀ IC_i X, children first (higher index), the contribution of body i + 1 to
+    // body i riding in registers ([`add_to_parent`]); a rigid-body inertia stays four numbers
+    // (m, m c, I_o) in every frame. ic[0] collects the roots' shares, unused: that spares a
+    // branch per body.
+    let mut carry = Inertia::ZERO;
     for i in (1..nb).rev() {
-        let p = bodies[i].parent;
-        if p > 0 {
-            let ic = data.ic[i].to_parent(&data.x_up[i]);
-            data.ic[p] += ic;
-        }
+        let ic_i = ic[i] + carry;
+        ic[i] = ic_i;
+        carry = add_to_parent(ic, ic_i.to_parent(&x_up[i]), i, bodies[i].parent);
     }
     let n = model.nv();
     let m = data.mass_matrix.as_mut_slice();
     m.fill(0.0);
     for i in 1..nb {
         let bi = &bodies[i];
+        let (iv, col) = (bi.idx_v, bi.idx_v * n);
         // F = IC_i S_i ;  H_ii = S_iᵀ F
-        let mut f = data.ic[i].mul_motion(&bi.s);
-        m[bi.idx_v * (n + 1)] = bi.s.dot(&f);
-        let mut j = i;
-        while bodies[j].parent > 0 {
+        let mut f = composite_times_s(bi, &ic[i]);
+        m[col + iv] = s_dot_composite(bi, &f);
+        let (mut j, mut p) = (i, bi.parent);
+        while p > 0 {
             // F = X_jᵀ F ;  j = λ(j) ;  H_ij = H_ji = S_jᵀ F
-            f = data.x_up[j].apply_force_transpose(&f);
-            j = bodies[j].parent;
-            let bj = &bodies[j];
-            let h = bj.s.dot(&f);
-            m[bi.idx_v + n * bj.idx_v] = h;
-            m[bj.idx_v + n * bi.idx_v] = h;
+            f = x_up[j].apply_force_transpose(&f);
+            let bp = &bodies[p];
+            let h = s_dot_composite(bp, &f);
+            m[col + bp.idx_v] = h;
+            m[bp.idx_v * n + iv] = h;
+            (j, p) = (p, bp.parent);
         }
+    }
+}
+
+/// `IC S` for a body's joint: the first column of the inertia matrix for a revolute joint
+/// (`[I_o, −h_y, h_x]`), two columns combined for a prismatic one.
+#[inline(always)]
+fn composite_times_s(b: &BodyModel, ic: &Inertia) -> Force {
+    match b.joint {
+        JointType::Revolute => Force::new(ic.i_o, -ic.hy, ic.hx),
+        JointType::Prismatic { .. } => ic.mul_motion(&b.s),
+    }
+}
+
+/// `Sᵀ F` for `F = IC S` carried up the tree, reading only the components `S` selects
+/// (compare [`BodyModel::s_dot`], which keeps the zero products so that overflowed forces
+/// show). Here no component can overflow alone: a first moment `m c` too large for a double
+/// comes with a rotational inertia `m |c|²` larger still, and that reaches the moment `n`.
+#[inline(always)]
+fn s_dot_composite(b: &BodyModel, f: &Force) -> f64 {
+    match b.joint {
+        JointType::Revolute => f.n,
+        JointType::Prismatic { .. } => b.s.vx * f.fx + b.s.vy * f.fy,
     }
 }
 
@@ -101,10 +130,14 @@ pub(crate) fn factor_mass_matrix(model: &Model, data: &mut Data) -> Result<()> {
     let n = model.nv();
     let m = data.mass_matrix.as_slice();
     let h = &mut data.factor;
-    // h[r + n c] with r, c = body index − 1.
-    for c in 1..bodies.len() {
-        for r in 1..bodies.len() {
-            h[(r - 1) + n * (c - 1)] = m[bodies[r].idx_v + n * bodies[c].idx_v];
+    // h[r + n c] with r, c = body index − 1, for c = r and its ancestors: the only entries
+    // the factorisation reads or writes (the others stay zero in L), so the only ones copied.
+    for r in 1..bodies.len() {
+        let row = bodies[r].idx_v;
+        let mut c = r;
+        while c > 0 {
+            h[(r - 1) + n * (c - 1)] = m[row + n * bodies[c].idx_v];
+            c = bodies[c].parent;
         }
     }
     let parent = |k: usize| bodies[k + 1].parent.checked_sub(1);

@@ -151,3 +151,66 @@ impl Data {
         self.f[body.0]
     }
 }
+
+/// The entry of body `i`'s parent `p` in a per-body array being filled in body order, with
+/// `prev` the entry just computed for body `i − 1`. When the parent is the previous body
+/// (always, along a chain) the value comes from `prev`, still in registers, rather than
+/// from the store just made: a forward recursion then does not wait on memory at each body.
+#[inline(always)]
+pub(crate) fn parent_entry<T: Copy>(entries: &[T], prev: T, i: usize, p: usize) -> T {
+    if p + 1 == i { prev } else { entries[p] }
+}
+
+/// Hands body `i`'s contribution `c` to its parent `p` in a backward (leaves-first) pass.
+/// When the parent is the next body processed (`p = i − 1`, always along a chain), `c` is
+/// returned to be added there from registers; otherwise it is added to `entries[p]` and zero
+/// is returned. The caller adds what this returns to the next body's entry: each parent then
+/// receives its children's contributions in the same order as with plain `entries[p] += c`,
+/// so the sums are identical bit for bit.
+#[inline(always)]
+pub(crate) fn add_to_parent<T: Copy + Default + std::ops::AddAssign>(
+    entries: &mut [T],
+    c: T,
+    i: usize,
+    p: usize,
+) -> T {
+    if p + 1 == i {
+        c
+    } else {
+        entries[p] += c;
+        T::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parent_entry_reads_the_previous_body_from_registers_only_for_it() {
+        let entries = [10.0, 11.0, 12.0];
+        // Body 3's parent is body 2, just computed: `prev` is used, not the stale store.
+        assert_eq!(parent_entry(&entries, 99.0, 3, 2), 99.0);
+        assert_eq!(parent_entry(&entries, 99.0, 3, 1), 11.0);
+    }
+
+    #[test]
+    fn add_to_parent_sums_in_the_order_of_plain_accumulation() {
+        // Parent 1 with children 2, 3, 4 (processed 4, 3, 2); values chosen so that the
+        // order of the additions shows in the last bit.
+        let own: f64 = 1.0;
+        let c: [f64; 5] = [0.0, 0.0, 1e-16, 3e-16, 1.0];
+        let mut plain = [0.0, own, 0.0, 0.0, 0.0];
+        for i in (2..=4).rev() {
+            plain[1] += c[i];
+        }
+        let mut entries = [0.0, own, 0.0, 0.0, 0.0];
+        let mut carry: f64 = 0.0;
+        for i in (2..=4).rev() {
+            entries[i] += carry;
+            carry = add_to_parent(&mut entries, c[i], i, 1);
+        }
+        entries[1] += carry;
+        assert_eq!(entries[1].to_bits(), plain[1].to_bits());
+    }
+}

@@ -1,7 +1,7 @@
 //! Forward kinematics: body poses, velocities and accelerations, and the position, velocity
 //! and acceleration of body-fixed points.
 
-use crate::data::Data;
+use crate::data::{Data, parent_entry};
 use crate::error::{Result, check_input};
 use crate::model::{BodyId, Model};
 use crate::spatial::{Motion, Transform};
@@ -50,17 +50,49 @@ pub fn forward_kinematics_acc(
 /// Joint transforms, world poses and, when `v` is given, body velocities (inputs already
 /// checked).
 pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: Option<&[f64]>) {
-    data.x_world[0] = Transform::IDENTITY;
-    data.v[0] = Motion::ZERO;
-    for i in 1..model.bodies.len() {
-        let b = &model.bodies[i];
-        let x = b.joint_transform(q[b.idx_v]);
-        data.x_up[i] = x;
-        data.x_world[i] = data.x_world[b.parent].compose(&x);
-        if let Some(v) = v {
+    joint_transforms(model, data, q);
+    if let Some(v) = v {
+        let bodies = model.bodies.as_slice();
+        let nb = bodies.len();
+        let x_up = &data.x_up[..nb];
+        let vel = &mut data.v[..nb];
+        vel[0] = Motion::ZERO;
+        let mut v_prev = Motion::ZERO;
+        for i in 1..nb {
+            let b = &bodies[i];
             // v_i = X v_λ + S q̇
-            data.v[i] = x.apply_motion(&data.v[b.parent]) + b.s * v[b.idx_v];
+            let vi = b.add_s(
+                x_up[i].apply_motion(&parent_entry(vel, v_prev, i, b.parent)),
+                v[b.idx_v],
+            );
+            vel[i] = vi;
+            v_prev = vi;
         }
+    }
+}
+
+/// The joint transforms `data.x_up` and world poses `data.x_world` for configuration `q`
+/// (inputs already checked): the first step of every algorithm.
+///
+/// Two loops rather than one: the first holds nothing but the sines and cosines, which do
+/// not depend on each other, so that the processor overlaps those library calls and keeps
+/// little in registers across them; the second composes the poses down the tree.
+pub(crate) fn joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
+    let bodies = model.bodies.as_slice();
+    let nb = bodies.len();
+    // Per-body arrays cut to the body count: indexing by the loop counter needs no check.
+    let x_up = &mut data.x_up[..nb];
+    let x_world = &mut data.x_world[..nb];
+    for i in 1..nb {
+        let b = &bodies[i];
+        x_up[i] = b.joint_transform(q[b.idx_v]);
+    }
+    x_world[0] = Transform::IDENTITY;
+    let mut xw_prev = Transform::IDENTITY;
+    for i in 1..nb {
+        let xw = parent_entry(x_world, xw_prev, i, bodies[i].parent).compose(&x_up[i]);
+        x_world[i] = xw;
+        xw_prev = xw;
     }
 }
 

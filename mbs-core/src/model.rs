@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 
 use crate::error::{CoreError, Result};
-use crate::spatial::{Inertia, Motion, Transform};
+use crate::spatial::{Force, Inertia, Motion, Transform};
 
 /// Index of a body in a [`Model`]. Body 0 is the ground ([`BodyId::GROUND`]); moving bodies
 /// are numbered from 1 in topological order (a parent always has a smaller index than its
@@ -92,6 +92,48 @@ impl BodyModel {
                 x: self.x_tree.x + q * self.axis_parent[0],
                 y: self.x_tree.y + q * self.axis_parent[1],
             },
+        }
+    }
+
+    /// `Sᵀ f`: the generalized force of a body-frame spatial force on this joint.
+    ///
+    /// The zero components of `S` still multiply their force components, as in the full
+    /// product: a state so large that a force overflows (`v = 1e300` squares to infinity in
+    /// the centripetal force, which a revolute joint does not feel) then gives a NaN
+    /// generalized force that callers report, rather than a finite number from an
+    /// overflowed computation.
+    #[inline(always)]
+    pub fn s_dot(&self, f: &Force) -> f64 {
+        match self.joint {
+            JointType::Revolute => f.n + 0.0 * f.fx + 0.0 * f.fy,
+            JointType::Prismatic { .. } => 0.0 * f.n + self.s.vx * f.fx + self.s.vy * f.fy,
+        }
+    }
+
+    /// `m + S k`: adds a joint rate (or acceleration) `k` to a body-frame motion.
+    #[inline(always)]
+    pub fn add_s(&self, m: Motion, k: f64) -> Motion {
+        match self.joint {
+            JointType::Revolute => Motion { w: m.w + k, ..m },
+            JointType::Prismatic { .. } => Motion {
+                w: m.w,
+                vx: m.vx + self.s.vx * k,
+                vy: m.vy + self.s.vy * k,
+            },
+        }
+    }
+
+    /// `v ×ₘ S k`: the velocity-product acceleration of a joint moving at rate `k` on a body
+    /// moving at `v`. Its angular part is zero for both joint kinds.
+    #[inline(always)]
+    pub fn cross_s(&self, v: &Motion, k: f64) -> Motion {
+        match self.joint {
+            // [0, vy k, −vx k]
+            JointType::Revolute => Motion::new(0.0, v.vy * k, -v.vx * k),
+            // [0, −w ay k, w ax k]
+            JointType::Prismatic { .. } => {
+                Motion::new(0.0, -v.w * (self.s.vy * k), v.w * (self.s.vx * k))
+            }
         }
     }
 }

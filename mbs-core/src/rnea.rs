@@ -3,8 +3,9 @@
 
 use nalgebra::DVector;
 
-use crate::data::Data;
+use crate::data::{Data, add_to_parent, parent_entry};
 use crate::error::{CoreError, Result, check_input};
+use crate::kinematics::joint_transforms;
 use crate::model::Model;
 use crate::spatial::{Force, Motion};
 
@@ -133,6 +134,11 @@ pub(crate) enum Output {
 
 /// RNEA proper; `None` velocity or acceleration means zero; `None` configuration means the
 /// joint transforms and poses in `data` are already those of the configuration.
+///
+/// Always inlined: each caller passes constant `Some`/`None` arguments, so each gets a copy
+/// with the unused terms removed (no velocity products in `gravity_torque`, no `S q̈` in
+/// `nonlinear_effects`, no joint transforms after the CRBA has made them).
+#[inline(always)]
 pub(crate) fn rnea_pass(
     model: &Model,
     data: &mut Data,
@@ -142,51 +148,70 @@ pub(crate) fn rnea_pass(
     f_ext: Option<&[Force]>,
     output: Output,
 ) {
+    if let Some(q) = q {
+        joint_transforms(model, data, q);
+    }
+    let bodies = model.bodies.as_slice();
+    let nb = bodies.len();
     let g = model.gravity;
-    data.v[0] = Motion::ZERO;
-    data.a[0] = Motion::new(0.0, -g[0], -g[1]);
-    let bodies = &model.bodies;
-    for i in 1..bodies.len() {
+    // Per-body arrays cut to the body count: indexing by the loop counter needs no check.
+    let x_up = &data.x_up[..nb];
+    let vel = &mut data.v[..nb];
+    let acc = &mut data.a[..nb];
+    let frc = &mut data.f[..nb];
+    let a0 = Motion::new(0.0, -g[0], -g[1]);
+    vel[0] = Motion::ZERO;
+    acc[0] = a0;
+    // The previous body's velocity and acceleration, read from registers when it is the
+    // parent ([`parent_entry`]).
+    let (mut v_prev, mut a_prev) = (Motion::ZERO, a0);
+    for i in 1..nb {
         let b = &bodies[i];
+        let p = b.parent;
         let iv = b.idx_v;
-        let x = match q {
-            Some(q) => {
-                let x = b.joint_transform(q[iv]);
-                data.x_up[i] = x;
-                data.x_world[i] = data.x_world[b.parent].compose(&x);
-                x
-            }
-            None => data.x_up[i],
-        };
-        let qd = v.map_or(0.0, |v| v[iv]);
-        let qdd = a.map_or(0.0, |a| a[iv]);
-        let vj = b.s * qd;
-        // v_i = X v_λ + S q̇ ;  a_i = X a_λ + S q̈ + v_i ×ₘ S q̇
-        let vi = x.apply_motion(&data.v[b.parent]) + vj;
-        let ai = x.apply_motion(&data.a[b.parent]) + b.s * qdd + vi.cross_motion(&vj);
-        data.v[i] = vi;
-        data.a[i] = ai;
-        // f_i = I a_i + v_i ×f I v_i − f_ext,i
-        let mut f = b.inertia.mul_motion(&ai) + vi.cross_force(&b.inertia.mul_motion(&vi));
-        if let Some(fe) = f_ext {
-            f -= fe[i];
+        let x = x_up[i];
+        // a_i = X a_λ + S q̈ + v_i ×ₘ S q̇
+        let mut ai = x.apply_motion(&parent_entry(acc, a_prev, i, p));
+        if let Some(a) = a {
+            ai = b.add_s(ai, a[iv]);
         }
-        data.f[i] = f;
+        let (vi, f) = match v {
+            Some(v) => {
+                // v_i = X v_λ + S q̇ ;  f_i = I a_i + v_i ×f I v_i
+                let qd = v[iv];
+                let vi = b.add_s(x.apply_motion(&parent_entry(vel, v_prev, i, p)), qd);
+                ai += b.cross_s(&vi, qd);
+                let f = b.inertia.mul_motion(&ai) + vi.cross_force(&b.inertia.mul_motion(&vi));
+                (vi, f)
+            }
+            None => (Motion::ZERO, b.inertia.mul_motion(&ai)),
+        };
+        vel[i] = vi;
+        acc[i] = ai;
+        (v_prev, a_prev) = (vi, ai);
+        // − f_ext,i
+        frc[i] = match f_ext {
+            Some(fe) => f - fe[i],
+            None => f,
+        };
     }
     let out = match output {
         Output::Tau => data.tau.as_mut_slice(),
         Output::Nle => data.nle.as_mut_slice(),
         Output::Gravity => data.gravity.as_mut_slice(),
     };
-    for i in (1..bodies.len()).rev() {
+    let mut carry = Force::ZERO;
+    for i in (1..nb).rev() {
         let b = &bodies[i];
-        // τ_i = Sᵀ f_i ;  f_λ += Xᵀ f_i
-        out[b.idx_v] = b.s.dot(&data.f[i]);
-        if b.parent > 0 {
-            let fp = data.x_up[i].apply_force_transpose(&data.f[i]);
-            data.f[b.parent] += fp;
-        }
+        // τ_i = Sᵀ f_i ;  f_λ += Xᵀ f_i, the contribution of body i + 1 to body i riding in
+        // registers ([`add_to_parent`]); the ground's entry takes the roots' shares.
+        let fi = frc[i] + carry;
+        frc[i] = fi;
+        out[b.idx_v] = b.s_dot(&fi);
+        carry = add_to_parent(frc, x_up[i].apply_force_transpose(&fi), i, b.parent);
     }
+    // The ground's entry took the base reaction of any root after the first.
+    frc[0] = Force::ZERO;
 }
 
 /// Generalized forces `Σ Jᵀ f` of body forces `f_local` (body frames), using the joint
@@ -199,14 +224,16 @@ pub(crate) fn body_forces_to_generalized(
     acc: &mut [Force],
     out: &mut [f64],
 ) {
-    let bodies = &model.bodies;
-    acc.copy_from_slice(f_local);
-    for i in (1..bodies.len()).rev() {
+    let bodies = model.bodies.as_slice();
+    let nb = bodies.len();
+    let x_up = &data.x_up[..nb];
+    let acc = &mut acc[..nb];
+    acc.copy_from_slice(&f_local[..nb]);
+    for i in (1..nb).rev() {
         let b = &bodies[i];
-        out[b.idx_v] = b.s.dot(&acc[i]);
-        if b.parent > 0 {
-            let fp = data.x_up[i].apply_force_transpose(&acc[i]);
-            acc[b.parent] += fp;
-        }
+        // τ_i = Sᵀ f_i ;  f_λ += Xᵀ f_i (acc[0], scratch, takes the ground's share)
+        let fi = acc[i];
+        out[b.idx_v] = b.s_dot(&fi);
+        acc[b.parent] += x_up[i].apply_force_transpose(&fi);
     }
 }
