@@ -121,7 +121,9 @@ pub(crate) struct IterationMatrix {
     /// States with a zero Jacobian column.
     passive: Vec<usize>,
     lu: Lu,
-    /// `c J_ZA`, row-major over the passive states (`passive.len() × active.len()`).
+    /// The passive states whose row of `J_ZA` is not zero.
+    coupled: Vec<usize>,
+    /// `c J_ZA`, row-major over the coupled states (`coupled.len() × active.len()`).
     coupling: Vec<f64>,
     /// The active block `J_AA`, column-major, then work space for a solve.
     block: Vec<f64>,
@@ -138,6 +140,7 @@ impl IterationMatrix {
             // Room for every split of the states, so that none allocates later.
             passive: Vec::with_capacity(n),
             lu: Lu::new(n),
+            coupled: Vec::with_capacity(n),
             coupling: Vec::with_capacity(n * n / 4 + 1),
             block: vec![0.0; n * n],
             work: vec![0.0; n],
@@ -176,10 +179,16 @@ impl IterationMatrix {
                 self.block[rb + na * cb] = jac[i + n * j];
             }
         }
+        // Only the passive states whose rates depend on active ones need a row: a string's
+        // modal amplitudes out of contact have none, and then a solve costs no product.
         self.coupling.clear();
+        self.coupled.clear();
         for &i in &self.passive {
-            self.coupling
-                .extend(self.active.iter().map(|&j| c * jac[i + n * j]));
+            if self.active.iter().any(|&j| jac[i + n * j] != 0.0) {
+                self.coupled.push(i);
+                self.coupling
+                    .extend(self.active.iter().map(|&j| c * jac[i + n * j]));
+            }
         }
         self.lu.factor_shifted(c, &self.block)
     }
@@ -193,7 +202,7 @@ impl IterationMatrix {
         for (k, &i) in self.active.iter().enumerate() {
             b[i] = self.work[k];
         }
-        for (row, &i) in self.coupling.chunks_exact(na.max(1)).zip(&self.passive) {
+        for (row, &i) in self.coupling.chunks_exact(na.max(1)).zip(&self.coupled) {
             b[i] += row.iter().zip(&self.work).map(|(a, x)| a * x).sum::<f64>();
         }
     }
@@ -258,6 +267,26 @@ mod tests {
         w.solve(&mut b);
         for i in 0..n {
             assert!((b[i] - x[i]).abs() < 1e-14, "{b:?}");
+        }
+        assert_eq!(w.coupled, vec![1, 3]);
+        // State 3 made independent of the others: its row is dropped, its solution is b.
+        set(&mut jac, 3, 2, 0.0);
+        w.jacobian_changed();
+        assert!(w.factor_shifted(c, &jac));
+        assert_eq!(w.coupled, vec![1]);
+        let mut b = [0.7, -1.1, 2.3, 0.4];
+        let rhs = b;
+        w.solve(&mut b);
+        assert_eq!(b[3], rhs[3]);
+        let mut back = [0.0; 4];
+        for i in 0..n {
+            back[i] = b[i];
+            for j in 0..n {
+                back[i] -= c * jac[i + n * j] * b[j];
+            }
+        }
+        for i in 0..n {
+            assert!((back[i] - rhs[i]).abs() < 1e-14, "{back:?}");
         }
         // A full Jacobian again: every state active.
         let full: Vec<f64> = (0..n * n).map(|k| 0.1 * (k as f64 + 1.0)).collect();
