@@ -41,15 +41,12 @@ const NEWTON_TOL: f64 = 0.03;
 /// A Newton contraction rate above this marks the Jacobian stale: it is re-evaluated at
 /// the start of the next step (Hairer & Wanner's RADAU5 uses the same idea). A finite-
 /// difference Jacobian costs a derivative evaluation per state, a slower contraction about
-/// one more iteration per stage: 0.3 balances them (the loud keystroke: 0.1 took 312
-/// Jacobians and 9 506 evaluations, 0.3 takes 226 and 8 812; 0.5 costs more again).
+/// one more iteration per stage: 0.3 balances them (0.5 costs more again).
 const SLOW_RATE: f64 = 0.3;
 /// The first contraction estimate (second iteration against the first) may exceed 1 when
 /// the predictor lies outside the range where the stage equation is nearly linear (a
 /// felt's rate-sign switch, a friction's `tanh`); only a rate above this at the first
-/// estimate, or above [`DIVERGENT_RATE`] later, is taken as divergence. With this, the
-/// guess below and [`SLOW_RATE`], the loud keystroke's steps rejected for a Newton failure
-/// fell from 124 to 85 and its evaluations from 10 291 to 8 810.
+/// estimate, or above [`DIVERGENT_RATE`] later, is taken as divergence.
 const FIRST_DIVERGENT_RATE: f64 = 2.0;
 /// A contraction rate at or above this after the first estimate is divergence.
 const DIVERGENT_RATE: f64 = 0.9;
@@ -66,10 +63,6 @@ pub(crate) struct TrBdf2 {
     f_prev: Vec<f64>,
     z_gamma: Vec<f64>,
     f_gamma: Vec<f64>,
-    /// The last accepted step's trapezoidal stage and step size, for the predictor (no
-    /// previous step right after a start).
-    zg_last: Vec<f64>,
-    h_last: Option<f64>,
     z_end: Vec<f64>,
     f_end: Vec<f64>,
     psi: Vec<f64>,
@@ -125,8 +118,6 @@ impl TrBdf2 {
             f_prev: v(),
             z_gamma: v(),
             f_gamma: v(),
-            zg_last: v(),
-            h_last: None,
             z_end: v(),
             f_end: v(),
             psi: v(),
@@ -402,27 +393,12 @@ impl TrBdf2 {
         let c = h * D;
         self.factor(c, st)?;
         let n = self.n;
-        // Trapezoidal stage: z_γ = y + h d (f_n + f(z_γ)).
+        // Trapezoidal stage: z_γ = y + h d (f_n + f(z_γ)), guess y + γ h f_n. (A guess
+        // extrapolated from the last step's states saved about 2 % of the evaluations but
+        // doubled the error of soft blows' hammer speed against a tight run: not kept.)
         for i in 0..n {
             self.psi[i] = self.y[i] + c * self.f[i];
-        }
-        // Guess: the quadratic through the last step's three states (its start, trapezoidal
-        // stage and end) extrapolated to t + γh; the current state right after a start.
-        // States only, no derivatives: on a stiff component `h f` is far larger than the
-        // change it makes, so an Euler guess `y + γ h f` lands far off (the loud keystroke:
-        // 9 437 evaluations with it, 8 812 with this guess).
-        match self.h_last {
-            Some(hl) => {
-                let (s0, s1) = (-hl, (GAMMA - 1.0) * hl);
-                let x = GAMMA * h;
-                let l0 = (x - s1) * x / ((s0 - s1) * s0);
-                let l1 = (x - s0) * x / ((s1 - s0) * s1);
-                let l2 = (x - s0) * (x - s1) / (s0 * s1);
-                for i in 0..n {
-                    self.z_gamma[i] = l0 * self.y_prev[i] + l1 * self.zg_last[i] + l2 * self.y[i];
-                }
-            }
-            None => self.z_gamma.copy_from_slice(&self.y),
+            self.z_gamma[i] = self.y[i] + GAMMA * h * self.f[i];
         }
         if let Stage::Failed = self.newton(sys, self.t + GAMMA * h, c, false, st)? {
             self.failed_in_end_stage = false;
@@ -462,7 +438,6 @@ impl Stepper for TrBdf2 {
         }
         // After a restart (event) the old Jacobian may be far off: refresh lazily.
         self.jac_valid = false;
-        self.h_last = None;
         Ok(())
     }
 
@@ -575,8 +550,6 @@ impl Stepper for TrBdf2 {
 
 impl TrBdf2 {
     fn accept(&mut self, h: f64, st: &mut Stats) {
-        self.zg_last.copy_from_slice(&self.z_gamma);
-        self.h_last = Some(h);
         std::mem::swap(&mut self.y_prev, &mut self.y);
         std::mem::swap(&mut self.f_prev, &mut self.f);
         self.y.copy_from_slice(&self.z_end);
