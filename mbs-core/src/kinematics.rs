@@ -3,8 +3,14 @@
 
 use crate::data::{Data, parent_entry};
 use crate::error::{Result, check_input};
-use crate::model::{BodyId, Model};
+use crate::model::{BodyId, BodyModel, JointType, Model};
 use crate::spatial::{Motion, Transform};
+use crate::trig::sin_cos_lanes;
+
+/// Joint angles whose sines and cosines are computed together in [`joint_transforms`]: four
+/// doubles fill two SSE2 registers or one AVX register. (Eight, one pass for the 5-link
+/// chain, measured slower: 115 → 124 ns for its CRBA, 137 ns with `target-cpu=native`.)
+const TRIG_LANES: usize = 4;
 
 /// Computes the world pose of every body for configuration `q`.
 pub fn update_poses(model: &Model, data: &mut Data, q: &[f64]) -> Result<()> {
@@ -74,18 +80,26 @@ pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: Opti
 /// The joint transforms `data.x_up` and world poses `data.x_world` for configuration `q`
 /// (inputs already checked): the first step of every algorithm.
 ///
-/// Two loops rather than one: the first holds nothing but the sines and cosines, which do
-/// not depend on each other, so that the processor overlaps those library calls and keeps
-/// little in registers across them; the second composes the poses down the tree.
+/// Two passes rather than one: the first computes the joint transforms, with the sines and
+/// cosines of [`TRIG_LANES`] joint angles at a time ([`sin_cos_lanes`], vectorized) and the
+/// remaining few one by one; the second composes the poses down the tree.
 pub(crate) fn joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
     let bodies = model.bodies.as_slice();
     let nb = bodies.len();
     // Per-body arrays cut to the body count: indexing by the loop counter needs no check.
     let x_up = &mut data.x_up[..nb];
     let x_world = &mut data.x_world[..nb];
-    for i in 1..nb {
-        let b = &bodies[i];
-        x_up[i] = b.joint_transform(q[b.idx_v]);
+    let (moving, x_up_moving) = (&bodies[1..], &mut x_up[1..]);
+    let full = moving.len() / TRIG_LANES * TRIG_LANES;
+    for (chunk, x_up) in moving[..full]
+        .chunks_exact(TRIG_LANES)
+        .zip(x_up_moving[..full].chunks_exact_mut(TRIG_LANES))
+    {
+        set_joint_transforms::<TRIG_LANES>(chunk, x_up, q);
+    }
+    // The last few bodies one at a time (same arithmetic, same results, no padded lanes).
+    for (b, x_up) in moving[full..].iter().zip(&mut x_up_moving[full..]) {
+        set_joint_transforms::<1>(std::slice::from_ref(b), std::slice::from_mut(x_up), q);
     }
     x_world[0] = Transform::IDENTITY;
     let mut xw_prev = Transform::IDENTITY;
@@ -93,6 +107,31 @@ pub(crate) fn joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
         let xw = parent_entry(x_world, xw_prev, i, bodies[i].parent).compose(&x_up[i]);
         x_world[i] = xw;
         xw_prev = xw;
+    }
+}
+
+/// The joint transforms of `N` bodies (`x_up` of the same length), with the sines and
+/// cosines of their joint angles computed together.
+#[inline(always)]
+fn set_joint_transforms<const N: usize>(bodies: &[BodyModel], x_up: &mut [Transform], q: &[f64]) {
+    // θ = θ_tree + q for revolute joints; prismatic lanes get 0 and are not used.
+    let mut theta = [0.0; N];
+    for (theta, b) in theta.iter_mut().zip(bodies) {
+        if b.joint == JointType::Revolute {
+            *theta = b.theta_tree + q[b.idx_v];
+        }
+    }
+    let (sin, cos) = sin_cos_lanes(&theta);
+    for (j, (x, b)) in x_up.iter_mut().zip(bodies).enumerate() {
+        *x = match b.joint {
+            JointType::Revolute => Transform {
+                c: cos[j],
+                s: sin[j],
+                x: b.x_tree.x,
+                y: b.x_tree.y,
+            },
+            JointType::Prismatic { .. } => b.joint_transform(q[b.idx_v]),
+        };
     }
 }
 

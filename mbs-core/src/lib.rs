@@ -70,6 +70,7 @@ mod rnea;
 pub mod spatial;
 mod system;
 pub mod time_function;
+mod trig;
 
 pub use aba::{Prescribed, aba, aba_with_forces, hybrid_dynamics};
 pub use builder::{BodySpec, JointKind, ModelBuilder, Placement};
