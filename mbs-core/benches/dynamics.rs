@@ -8,49 +8,12 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use mbs_core::benchmarks::{branching_tree, branching_tree_system, planar_chain};
+use mbs_core::benchmarks::{benchmark_state, branching_tree, branching_tree_system, planar_chain};
 use mbs_core::{Data, Model, aba, crba, forward_dynamics_crba, rnea};
-
-/// The state of the reference file for the chain; a deterministic spread for the tree.
-fn state(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    if model.nv() == 5 {
-        (
-            vec![
-                1.721316619099806,
-                -0.38403808930179695,
-                2.2531371815723604,
-                1.2400999002927886,
-                -2.5498589250729733,
-            ],
-            vec![
-                1.9024894065470237,
-                1.0445588079614119,
-                1.1442572211078152,
-                -1.4875454692978165,
-                -0.19845624841773146,
-            ],
-            vec![
-                -1.2920197576741876,
-                4.267649888486018,
-                1.4386512008066452,
-                3.227616132708299,
-                -0.5658580117266885,
-            ],
-        )
-    } else {
-        let n = model.nv();
-        let f = |k: f64| {
-            (0..n)
-                .map(|i| ((i as f64 + 1.0) * k).sin() * 2.0)
-                .collect::<Vec<_>>()
-        };
-        (f(0.7), f(1.3), f(2.9))
-    }
-}
 
 fn bench_model(c: &mut Criterion, name: &str, model: &Model) {
     let mut data = Data::new(model);
-    let (q, v, a) = state(model);
+    let (q, v, a) = benchmark_state(model);
     let tau = rnea(model, &mut data, &q, &v, &a)
         .unwrap()
         .as_slice()

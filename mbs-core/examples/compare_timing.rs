@@ -21,7 +21,7 @@ use std::hint::black_box;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
-use mbs_core::benchmarks::{branching_tree, planar_chain};
+use mbs_core::benchmarks::{benchmark_state, branching_tree, planar_chain, spread};
 use mbs_core::{Data, Model, aba, crba, rnea};
 
 /// Batches timed per (model, algorithm).
@@ -62,13 +62,8 @@ fn time_per_call(mut call: impl FnMut() -> f64) -> Timing {
     }
 }
 
-/// `(i + 1) k` sines of amplitude 2: the deterministic spread of `benches/dynamics.rs`.
-fn spread(n: usize, k: f64) -> Vec<f64> {
-    (0..n).map(|i| ((i as f64 + 1.0) * k).sin() * 2.0).collect()
-}
-
-/// The state of the reference file for the chain, a deterministic spread for the tree (as
-/// `fn state` of `benches/dynamics.rs`), and the torque at which ABA's result is compared:
+/// The benchmarks' state (`mbs_core::benchmarks::benchmark_state`: the reference file's for
+/// the chain, a deterministic spread for the tree), and the torque at which ABA's result is compared:
 /// independent of either engine's RNEA, so a model mismatch shows.
 struct State {
     q: Vec<f64>,
@@ -79,33 +74,7 @@ struct State {
 
 fn state(model: &Model) -> State {
     let n = model.nv();
-    let (q, v, a) = if n == 5 {
-        (
-            vec![
-                1.721316619099806,
-                -0.38403808930179695,
-                2.2531371815723604,
-                1.2400999002927886,
-                -2.5498589250729733,
-            ],
-            vec![
-                1.9024894065470237,
-                1.0445588079614119,
-                1.1442572211078152,
-                -1.4875454692978165,
-                -0.19845624841773146,
-            ],
-            vec![
-                -1.2920197576741876,
-                4.267649888486018,
-                1.4386512008066452,
-                3.227616132708299,
-                -0.5658580117266885,
-            ],
-        )
-    } else {
-        (spread(n, 0.7), spread(n, 1.3), spread(n, 2.9))
-    };
+    let (q, v, a) = benchmark_state(model);
     State {
         q,
         v,

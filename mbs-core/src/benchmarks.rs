@@ -35,6 +35,45 @@ pub fn planar_chain(n: usize) -> Model {
         .unwrap_or_else(|e| unreachable!("planar_chain is valid: {e}"))
 }
 
+/// The state at which benchmarks and the Pinocchio comparison (`benches/compare/`) evaluate
+/// a model: `(q, v, a)` of the Pinocchio reference file for the 5-link chain, and for any
+/// other model the deterministic spread `2 sin((i + 1) k)` with `k = 0.7, 1.3, 2.9`.
+pub fn benchmark_state(model: &Model) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = model.nv();
+    if n == 5 {
+        (
+            vec![
+                1.721316619099806,
+                -0.38403808930179695,
+                2.2531371815723604,
+                1.2400999002927886,
+                -2.5498589250729733,
+            ],
+            vec![
+                1.9024894065470237,
+                1.0445588079614119,
+                1.1442572211078152,
+                -1.4875454692978165,
+                -0.19845624841773146,
+            ],
+            vec![
+                -1.2920197576741876,
+                4.267649888486018,
+                1.4386512008066452,
+                3.227616132708299,
+                -0.5658580117266885,
+            ],
+        )
+    } else {
+        (spread(n, 0.7), spread(n, 1.3), spread(n, 2.9))
+    }
+}
+
+/// `2 sin((i + 1) k)` for `i` in `0..n`: a deterministic spread of values.
+pub fn spread(n: usize, k: f64) -> Vec<f64> {
+    (0..n).map(|i| ((i as f64 + 1.0) * k).sin() * 2.0).collect()
+}
+
 /// A branching tree of 13 bodies on the ground: a trunk, three branches on it and three
 /// twigs on each branch, mixing revolute and prismatic joints (every third twig slides),
 /// with unequal masses and offsets so no symmetry hides an error.
