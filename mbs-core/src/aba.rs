@@ -262,7 +262,7 @@ fn project_joint(
     c: &Motion,
     tau: f64,
 ) -> (Projected, Force) {
-    match b.joint {
+    let (inertia, u_col, d_inv, u, pa_a) = match b.joint {
         JointType::Revolute => {
             let u_col = Force::new(ia.a00, ia.a01, ia.a02);
             let d_inv = 1.0 / ia.a00;
@@ -286,15 +286,7 @@ fn project_joint(
                 a12,
                 a22,
             };
-            (
-                Projected {
-                    inertia,
-                    u: u_col,
-                    d_inv,
-                    u_bias: u,
-                },
-                pa_a,
-            )
+            (inertia, u_col, d_inv, u, pa_a)
         }
         JointType::Prismatic { .. } => {
             let u_col = ia.mul_motion(&b.s);
@@ -302,15 +294,16 @@ fn project_joint(
             let u = tau - b.s_dot(pa);
             let inertia = ia.sub_outer(&u_col, d_inv);
             let pa_a = *pa + inertia.mul_motion(c) + u_col * (u * d_inv);
-            (
-                Projected {
-                    inertia,
-                    u: u_col,
-                    d_inv,
-                    u_bias: u,
-                },
-                pa_a,
-            )
+            (inertia, u_col, d_inv, u, pa_a)
         }
-    }
+    };
+    (
+        Projected {
+            inertia,
+            u: u_col,
+            d_inv,
+            u_bias: u,
+        },
+        pa_a,
+    )
 }
