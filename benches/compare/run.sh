@@ -97,8 +97,12 @@ if [[ ! -x $PIN_BIN || $HERE/pinocchio_bench.cpp -nt $PIN_BIN
 fi
 
 # --- Build our side (cargo skips the build when nothing changed) ------------------------
-say "cargo build --release -p mbs-core --example compare_timing"
-(cd "$ROOT" && CARGO_TARGET_DIR=target/compare/cargo \
+# For the machine it runs on, as Pinocchio is (-march=native): OURS_RUSTFLAGS= (empty) builds
+# for generic x86-64 instead. The flags are part of cargo's fingerprint, so changing them
+# rebuilds.
+OURS_RUSTFLAGS=${OURS_RUSTFLAGS--C target-cpu=native}
+say "RUSTFLAGS='$OURS_RUSTFLAGS' cargo build --release -p mbs-core --example compare_timing"
+(cd "$ROOT" && CARGO_TARGET_DIR=target/compare/cargo RUSTFLAGS="$OURS_RUSTFLAGS" \
     cargo build --quiet --release -p mbs-core --example compare_timing)
 OURS_BIN=$OUT/cargo/release/examples/compare_timing
 
@@ -116,7 +120,7 @@ done
 LOAD_AFTER=$(cut -d' ' -f1-3 /proc/loadavg)
 
 # --- Check the values, make the table ----------------------------------------------------
-export ROUNDS RUN_DIR VALUE_TOLERANCE PIN_VERSION LOAD_BEFORE LOAD_AFTER
+export ROUNDS RUN_DIR VALUE_TOLERANCE PIN_VERSION LOAD_BEFORE LOAD_AFTER OURS_RUSTFLAGS
 export CPU=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
 export CORES=$(nproc)
 export RUSTC=$(rustc --version)
@@ -193,7 +197,8 @@ def cell(m, lo, hi, digits):
 
 lines = [
     f"Pinocchio {os.environ['PIN_VERSION']} (native C++, {os.environ['GXX']}, "
-    f"-O3 -march=native) vs mbs-core ({os.environ['RUSTC']}, release profile)",
+    f"-O3 -march=native) vs mbs-core ({os.environ['RUSTC']}, release profile, "
+    f"RUSTFLAGS='{os.environ['OURS_RUSTFLAGS']}')",
     f"{os.environ['CPU']}, {os.environ['CORES']} cores; load average "
     f"{os.environ['LOAD_BEFORE']} before, {os.environ['LOAD_AFTER']} after; "
     f"{rounds} interleaved rounds, each the median of 30 batches.",

@@ -2,8 +2,11 @@
 //! reference file and on the 13-body branching tree. Run with `cargo bench -p mbs-core`.
 //!
 //! The goal (issue 16): each algorithm ≥ 4× native Pinocchio on both models, measured side
-//! by side by `benches/compare/run.sh` (its README has the latest table: on 2026-11-26 the
-//! 5-link chain took 0.096 / 0.094 / 0.160 µs here against Pinocchio's 0.53 / 0.21 / 1.07).
+//! by side by `benches/compare/run.sh` (its README has the latest tables: on a quiet machine
+//! on 2026-11-26 the 5-link chain took 0.096 / 0.094 / 0.160 µs here against Pinocchio's
+//! 0.53 / 0.21 / 1.07; the block CRBA of that afternoon takes it to about 0.065 µs built as
+//! here, for generic x86-64, and 0.055 µs with `-C target-cpu=native`, as the comparison
+//! builds it).
 
 use std::hint::black_box;
 

@@ -523,15 +523,15 @@ impl ModelBuilder {
             .enumerate()
             .map(|(i, f)| (f.name.clone(), i))
             .collect();
-        Model {
-            gravity: self.gravity,
+        Model::from_parts(
+            self.gravity,
             bodies,
             body_names,
             joint_names,
             body_of_coordinate,
             frames,
             frame_by_name,
-        }
+        )
     }
 }
 

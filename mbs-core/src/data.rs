@@ -15,6 +15,11 @@ use crate::spatial::{ArticulatedInertia, Force, Inertia, Motion, Transform};
 pub struct Data {
     /// Pose of each body's joint frame in its parent's joint frame.
     pub(crate) x_up: Vec<Transform>,
+    /// Sine of each revolute joint's angle, by coordinate, from the last CRBA (the slots of
+    /// prismatic coordinates are not used).
+    pub(crate) sin_q: Vec<f64>,
+    /// Cosine of each revolute joint's angle, by coordinate (see `sin_q`).
+    pub(crate) cos_q: Vec<f64>,
     /// Pose of each body's joint frame in the world.
     pub(crate) x_world: Vec<Transform>,
     /// Spatial velocity of each body, in its own frame.
@@ -23,8 +28,13 @@ pub struct Data {
     pub(crate) a: Vec<Motion>,
     /// Net spatial force transmitted by each joint (RNEA), in the body frame.
     pub(crate) f: Vec<Force>,
-    /// Composite rigid-body inertias (CRBA).
+    /// Composite rigid-body inertias being summed (CRBA), for the bodies with children other
+    /// than the next body (the others' sums ride in registers).
     pub(crate) ic: Vec<Inertia>,
+    /// The forces `F_j = IC_j S_j` of the mass matrix's columns (CRBA), by the position of
+    /// body `j` in the model's depth-first preorder, each in the frame of the body the
+    /// backward pass is at.
+    pub(crate) column_force: Vec<Force>,
     /// Articulated-body inertias (ABA).
     pub(crate) ia: Vec<ArticulatedInertia>,
     /// Articulated bias forces (ABA).
@@ -42,6 +52,10 @@ pub struct Data {
     pub(crate) nle: DVector<f64>,
     pub(crate) gravity: DVector<f64>,
     pub(crate) mass_matrix: DMatrix<f64>,
+    /// The [`crate::layout::Layout::id`] of the model whose zero pattern `mass_matrix` holds:
+    /// the entries between bodies on different branches, which the CRBA never writes, are
+    /// zero. Another model's CRBA zeroes the matrix first.
+    pub(crate) mass_matrix_zeros_for: u64,
     /// Tree-sparse LᵀL factor of the mass matrix, in body order.
     pub(crate) factor: Vec<f64>,
     /// Right-hand side / solution in body order.
@@ -55,11 +69,14 @@ impl Data {
         let nv = model.nv();
         Self {
             x_up: vec![Transform::IDENTITY; nb],
+            sin_q: vec![0.0; nv],
+            cos_q: vec![1.0; nv],
             x_world: vec![Transform::IDENTITY; nb],
             v: vec![Motion::ZERO; nb],
             a: vec![Motion::ZERO; nb],
             f: vec![Force::ZERO; nb],
             ic: vec![Inertia::ZERO; nb],
+            column_force: vec![Force::ZERO; nv],
             ia: vec![ArticulatedInertia::default(); nb],
             pa: vec![Force::ZERO; nb],
             c: vec![Motion::ZERO; nb],
@@ -71,6 +88,7 @@ impl Data {
             nle: DVector::zeros(nv),
             gravity: DVector::zeros(nv),
             mass_matrix: DMatrix::zeros(nv, nv),
+            mass_matrix_zeros_for: model.layout.id,
             factor: vec![0.0; nv * nv],
             rhs: vec![0.0; nv],
         }
@@ -114,7 +132,8 @@ impl Data {
     }
 
     /// World pose of a body's joint frame, for the configuration of the last call of any
-    /// algorithm (kinematics, dynamics or energy).
+    /// algorithm (kinematics, dynamics or energy) but [`crate::crba`], which needs only the
+    /// joint transforms and leaves the poses as they were.
     pub fn body_pose(&self, body: BodyId) -> Transform {
         self.x_world[body.0]
     }

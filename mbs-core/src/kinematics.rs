@@ -3,13 +3,16 @@
 
 use crate::data::{Data, parent_entry};
 use crate::error::{Result, check_input};
-use crate::model::{BodyId, BodyModel, JointType, Model};
+use crate::layout::RevoluteJoint;
+use crate::model::{BodyId, JointType, Model};
 use crate::spatial::{Motion, Transform};
 use crate::trig::sin_cos_lanes;
 
-/// Joint angles whose sines and cosines are computed together in [`joint_transforms`]: four
-/// doubles fill two SSE2 registers or one AVX register. (Eight, one pass for the 5-link
-/// chain, measured slower: 115 → 124 ns for its CRBA, 137 ns with `target-cpu=native`.)
+/// Joint angles whose sines and cosines are computed together in [`joint_transforms`] and
+/// [`joint_sin_cos`]: four doubles fill two SSE2 registers or one AVX register. (Eight, one
+/// pass for the 5-link chain, measured slower: 115 → 124 ns for its CRBA, 137 ns with
+/// `target-cpu=native`; measured again with the block CRBA, still slower by 10 % on the chain
+/// and 40 % on the tree with `target-cpu=native`.)
 const TRIG_LANES: usize = 4;
 
 /// Computes the world pose of every body for configuration `q`.
@@ -56,7 +59,7 @@ pub fn forward_kinematics_acc(
 /// Joint transforms, world poses and, when `v` is given, body velocities (inputs already
 /// checked).
 pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: Option<&[f64]>) {
-    joint_transforms(model, data, q);
+    joint_transforms_and_poses(model, data, q);
     if let Some(v) = v {
         let bodies = model.bodies.as_slice();
         let nb = bodies.len();
@@ -78,60 +81,179 @@ pub(crate) fn kinematics_pass(model: &Model, data: &mut Data, q: &[f64], v: Opti
 }
 
 /// The joint transforms `data.x_up` and world poses `data.x_world` for configuration `q`
-/// (inputs already checked): the first step of every algorithm.
-///
-/// Two passes rather than one: the first computes the joint transforms, with the sines and
-/// cosines of [`TRIG_LANES`] joint angles at a time ([`sin_cos_lanes`], vectorized) and the
-/// remaining few one by one; the second composes the poses down the tree.
+/// (inputs already checked): the first step of every algorithm but the CRBA, which needs
+/// the joint transforms only ([`joint_transforms`]).
+pub(crate) fn joint_transforms_and_poses(model: &Model, data: &mut Data, q: &[f64]) {
+    joint_transforms(model, data, q);
+    world_poses(model, data);
+}
+
+/// The joint transforms `data.x_up` for configuration `q` (inputs already checked): the
+/// revolute joints [`TRIG_LANES`] at a time, their sines and cosines computed together
+/// ([`sin_cos_lanes`], vectorized), the last few in one smaller group; then the prismatic
+/// joints, which need no trigonometry. (The CRBA takes the sines and cosines by coordinate
+/// instead, [`joint_sin_cos`], and reads them where it needs them.)
+#[inline(always)]
 pub(crate) fn joint_transforms(model: &Model, data: &mut Data, q: &[f64]) {
     let bodies = model.bodies.as_slice();
+    let x_up = &mut data.x_up[..bodies.len()];
+    let revolute = model.layout.revolute_joints.as_slice();
+    let mut groups = revolute.chunks_exact(TRIG_LANES);
+    for group in &mut groups {
+        set_revolute_transforms::<TRIG_LANES>(group, x_up, q);
+    }
+    // The rest in a group of its own size (a pair fills one SSE2 register, as one angle does).
+    let rest = groups.remainder();
+    match rest.len() {
+        0 => {}
+        1 => set_revolute_transforms::<1>(rest, x_up, q),
+        2 => set_revolute_transforms::<2>(rest, x_up, q),
+        _ => set_revolute_transforms::<3>(rest, x_up, q),
+    }
+    for &i in &model.layout.prismatic_bodies {
+        let b = &bodies[i];
+        x_up[i] = b.joint_transform(q[b.idx_v]);
+    }
+}
+
+/// The joint transforms of `N` revolute joints (`joints` of length `N`), with the sines and
+/// cosines of their angles `θ = θ_tree + q` computed together.
+#[inline(always)]
+fn set_revolute_transforms<const N: usize>(
+    joints: &[RevoluteJoint],
+    x_up: &mut [Transform],
+    q: &[f64],
+) {
+    let Ok(joints) = <&[RevoluteJoint; N]>::try_from(joints) else {
+        unreachable!("a group of {N} joints")
+    };
+    let theta: [f64; N] = std::array::from_fn(|k| joints[k].theta_tree + q[joints[k].coordinate]);
+    let (sin, cos) = sin_cos_lanes(&theta);
+    for (k, j) in joints.iter().enumerate() {
+        x_up[j.body] = Transform {
+            c: cos[k],
+            s: sin[k],
+            x: j.x,
+            y: j.y,
+        };
+    }
+}
+
+/// The joint transforms `data.x_up` from `data.sin_q`, `data.cos_q` (revolute joints) and
+/// `q` (prismatic joints).
+#[inline(always)]
+pub(crate) fn transforms_from_sin_cos(model: &Model, data: &mut Data, q: &[f64]) {
+    let bodies = model.bodies.as_slice();
     let nb = bodies.len();
-    // Per-body arrays cut to the body count: indexing by the loop counter needs no check.
     let x_up = &mut data.x_up[..nb];
+    let (sin_q, cos_q) = (data.sin_q.as_slice(), data.cos_q.as_slice());
+    for i in 1..nb {
+        let b = &bodies[i];
+        let k = b.idx_v;
+        x_up[i] = match b.joint {
+            JointType::Revolute => Transform {
+                c: cos_q[k],
+                s: sin_q[k],
+                x: b.x_tree.x,
+                y: b.x_tree.y,
+            },
+            JointType::Prismatic { .. } => b.joint_transform(q[k]),
+        };
+    }
+}
+
+/// The sines and cosines of the revolute joints' angles `θ = θ_tree + q` of configuration
+/// `q`, by coordinate, into `data.sin_q` and `data.cos_q` (the prismatic coordinates' slots
+/// are left alone): [`TRIG_LANES`] at a time ([`sin_cos_lanes`], vectorized), the few left
+/// over in one smaller group. When every joint is revolute, a group is consecutive slots,
+/// read and written in one go; otherwise its angles are gathered and its results scattered.
+/// Groups run from the last coordinate back, so that the leaves' come first, which the
+/// CRBA's backward pass needs first, and the left-over few, nearest the roots, last. Each
+/// lane's result depends on its own angle only, so these are the numbers [`joint_transforms`]
+/// puts in the transforms.
+#[inline(always)]
+pub(crate) fn joint_sin_cos(model: &Model, data: &mut Data, q: &[f64]) {
+    let n = model.nv();
+    let layout = &model.layout;
+    let at_zero = &layout.angle_at_zero[..n];
+    let (sin_q, cos_q) = (&mut data.sin_q[..n], &mut data.cos_q[..n]);
+    let q = &q[..n];
+    let revolute = layout.revolute_coordinates.as_slice();
+    let rest = revolute.len() % TRIG_LANES;
+    if revolute.len() == n {
+        for k in (rest..n).step_by(TRIG_LANES).rev() {
+            sin_cos_run::<TRIG_LANES>(k, at_zero, q, sin_q, cos_q);
+        }
+        match rest {
+            0 => {}
+            1 => sin_cos_run::<1>(0, at_zero, q, sin_q, cos_q),
+            2 => sin_cos_run::<2>(0, at_zero, q, sin_q, cos_q),
+            _ => sin_cos_run::<3>(0, at_zero, q, sin_q, cos_q),
+        }
+    } else {
+        for group in revolute[rest..].chunks_exact(TRIG_LANES).rev() {
+            sin_cos_gathered::<TRIG_LANES>(group, at_zero, q, sin_q, cos_q);
+        }
+        let group = &revolute[..rest];
+        match rest {
+            0 => {}
+            1 => sin_cos_gathered::<1>(group, at_zero, q, sin_q, cos_q),
+            2 => sin_cos_gathered::<2>(group, at_zero, q, sin_q, cos_q),
+            _ => sin_cos_gathered::<3>(group, at_zero, q, sin_q, cos_q),
+        }
+    }
+}
+
+/// The sines and cosines of the `N` joint angles of the consecutive coordinates from `k` on
+/// (a pair fills one SSE2 register, as one angle does).
+#[inline(always)]
+fn sin_cos_run<const N: usize>(
+    k: usize,
+    at_zero: &[f64],
+    q: &[f64],
+    sin_q: &mut [f64],
+    cos_q: &mut [f64],
+) {
+    let lanes = k..k + N;
+    let (at_zero, q) = (&at_zero[lanes.clone()], &q[lanes.clone()]);
+    let theta: [f64; N] = std::array::from_fn(|j| at_zero[j] + q[j]);
+    let (sin, cos) = sin_cos_lanes(&theta);
+    sin_q[lanes.clone()].copy_from_slice(&sin);
+    cos_q[lanes].copy_from_slice(&cos);
+}
+
+/// The sines and cosines of the joint angles of the `N` coordinates `group`.
+#[inline(always)]
+fn sin_cos_gathered<const N: usize>(
+    group: &[usize],
+    at_zero: &[f64],
+    q: &[f64],
+    sin_q: &mut [f64],
+    cos_q: &mut [f64],
+) {
+    let Ok(group) = <&[usize; N]>::try_from(group) else {
+        unreachable!("a group of {N} coordinates")
+    };
+    let theta: [f64; N] = std::array::from_fn(|j| at_zero[group[j]] + q[group[j]]);
+    let (sin, cos) = sin_cos_lanes(&theta);
+    for (j, &k) in group.iter().enumerate() {
+        (sin_q[k], cos_q[k]) = (sin[j], cos[j]);
+    }
+}
+
+/// The world poses `data.x_world`, composed down the tree from the joint transforms.
+#[inline(always)]
+pub(crate) fn world_poses(model: &Model, data: &mut Data) {
+    let bodies = model.bodies.as_slice();
+    let nb = bodies.len();
+    let x_up = &data.x_up[..nb];
     let x_world = &mut data.x_world[..nb];
-    let (moving, x_up_moving) = (&bodies[1..], &mut x_up[1..]);
-    let full = moving.len() / TRIG_LANES * TRIG_LANES;
-    for (chunk, x_up) in moving[..full]
-        .chunks_exact(TRIG_LANES)
-        .zip(x_up_moving[..full].chunks_exact_mut(TRIG_LANES))
-    {
-        set_joint_transforms::<TRIG_LANES>(chunk, x_up, q);
-    }
-    // The last few bodies one at a time (same arithmetic, same results, no padded lanes).
-    for (b, x_up) in moving[full..].iter().zip(&mut x_up_moving[full..]) {
-        set_joint_transforms::<1>(std::slice::from_ref(b), std::slice::from_mut(x_up), q);
-    }
     x_world[0] = Transform::IDENTITY;
     let mut xw_prev = Transform::IDENTITY;
     for i in 1..nb {
         let xw = parent_entry(x_world, xw_prev, i, bodies[i].parent).compose(&x_up[i]);
         x_world[i] = xw;
         xw_prev = xw;
-    }
-}
-
-/// The joint transforms of `N` bodies (`x_up` of the same length), with the sines and
-/// cosines of their joint angles computed together.
-#[inline(always)]
-fn set_joint_transforms<const N: usize>(bodies: &[BodyModel], x_up: &mut [Transform], q: &[f64]) {
-    // θ = θ_tree + q for revolute joints; prismatic lanes get 0 and are not used.
-    let mut theta = [0.0; N];
-    for (theta, b) in theta.iter_mut().zip(bodies) {
-        if b.joint == JointType::Revolute {
-            *theta = b.theta_tree + q[b.idx_v];
-        }
-    }
-    let (sin, cos) = sin_cos_lanes(&theta);
-    for (j, (x, b)) in x_up.iter_mut().zip(bodies).enumerate() {
-        *x = match b.joint {
-            JointType::Revolute => Transform {
-                c: cos[j],
-                s: sin[j],
-                x: b.x_tree.x,
-                y: b.x_tree.y,
-            },
-            JointType::Prismatic { .. } => b.joint_transform(q[b.idx_v]),
-        };
     }
 }
 

@@ -65,6 +65,7 @@ pub mod fuzzing;
 pub mod inspect;
 mod jacobian;
 mod kinematics;
+mod layout;
 mod model;
 mod rnea;
 pub mod spatial;

@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 
 use crate::error::{CoreError, Result};
+use crate::layout::Layout;
 use crate::spatial::{Force, Inertia, Motion, Transform};
 
 /// Index of a body in a [`Model`]. Body 0 is the ground ([`BodyId::GROUND`]); moving bodies
@@ -156,9 +157,34 @@ pub struct Model {
     pub(crate) body_of_coordinate: Vec<usize>,
     pub(crate) frames: Vec<Frame>,
     pub(crate) frame_by_name: BTreeMap<String, usize>,
+    /// Tables derived from `bodies` for the algorithms' hot loops.
+    pub(crate) layout: Layout,
 }
 
 impl Model {
+    /// A model from its parts, with the hot loops' tables derived from `bodies` (the one
+    /// place a model is put together: [`crate::ModelBuilder`] calls it).
+    pub(crate) fn from_parts(
+        gravity: [f64; 2],
+        bodies: Vec<BodyModel>,
+        body_names: Vec<String>,
+        joint_names: Vec<String>,
+        body_of_coordinate: Vec<usize>,
+        frames: Vec<Frame>,
+        frame_by_name: BTreeMap<String, usize>,
+    ) -> Model {
+        Model {
+            gravity,
+            layout: Layout::new(&bodies),
+            bodies,
+            body_names,
+            joint_names,
+            body_of_coordinate,
+            frames,
+            frame_by_name,
+        }
+    }
+
     /// Gravity acceleration in world coordinates (m/s²).
     pub fn gravity(&self) -> [f64; 2] {
         self.gravity

@@ -5,7 +5,7 @@ use nalgebra::DVector;
 
 use crate::data::{Data, add_to_parent, parent_entry};
 use crate::error::{CoreError, Result, check_input};
-use crate::kinematics::joint_transforms;
+use crate::kinematics::joint_transforms_and_poses;
 use crate::model::Model;
 use crate::spatial::{Force, Motion};
 
@@ -149,7 +149,7 @@ pub(crate) fn rnea_pass(
     output: Output,
 ) {
     if let Some(q) = q {
-        joint_transforms(model, data, q);
+        joint_transforms_and_poses(model, data, q);
     }
     let bodies = model.bodies.as_slice();
     let nb = bodies.len();

@@ -60,39 +60,39 @@ const COS_TAYLOR: [f64; 7] = [
     1.0 / 20_922_789_888_000.0,
 ];
 
-/// `(sin x, cos x)` for every lane of `x`, each within 2 ulp of `f64::sin_cos`. If any lane
-/// has `|x| > 1e5` or is not finite, the whole call is `f64::sin_cos` lane by lane (the
-/// function is crate-private, so this is not run as a doctest; the unit tests below check it):
+/// `(sin x, cos x)` for every lane of `x`, each within 2 ulp of `f64::sin_cos`. A lane with
+/// `|x| > 1e5`, or not finite, takes `f64::sin_cos`; the others are unaffected, so a lane's
+/// result never depends on the other lanes (the function is crate-private, so this is not run
+/// as a doctest; the unit tests below check it):
 ///
 /// ```text
 /// let (s, c) = sin_cos_lanes(&[0.0, 1.0, -2.0, 1e300]);
 /// assert_eq!(s[3], 1e300_f64.sin());
+/// assert_eq!(s[1], sin_cos_lanes(&[1.0]).0[0]);
 /// ```
 #[inline(always)]
 pub(crate) fn sin_cos_lanes<const N: usize>(x: &[f64; N]) -> ([f64; N], [f64; N]) {
-    // All lanes in range (NaN compares false), else the library one lane at a time.
-    let mut in_range = true;
-    for &xi in x {
-        in_range &= xi.abs() <= REDUCTION_LIMIT;
-    }
-    if !in_range {
-        let mut s = [0.0; N];
-        let mut c = [0.0; N];
-        for i in 0..N {
-            (s[i], c[i]) = x[i].sin_cos();
-        }
-        return (s, c);
-    }
     let mut s = [0.0; N];
     let mut c = [0.0; N];
     for i in 0..N {
         (s[i], c[i]) = sin_cos_reduced(x[i]);
     }
+    // Lanes out of range (NaN compares false) take the library's values, one by one: each
+    // lane's result depends on its own angle only, whatever the others hold.
+    let in_range = |xi: f64| xi.abs() <= REDUCTION_LIMIT;
+    if !x.iter().fold(true, |all, &xi| all & in_range(xi)) {
+        for i in 0..N {
+            if !in_range(x[i]) {
+                (s[i], c[i]) = x[i].sin_cos();
+            }
+        }
+    }
     (s, c)
 }
 
 /// `(sin x, cos x)` for `|x| ≤ REDUCTION_LIMIT`: no branches (selections are bit masks), so
-/// that the loop over lanes in [`sin_cos_lanes`] vectorizes.
+/// that the loop over lanes in [`sin_cos_lanes`] vectorizes. For other `x` (NaN included)
+/// the result is meaningless but harmless (no panic), and [`sin_cos_lanes`] replaces it.
 #[inline(always)]
 fn sin_cos_reduced(x: f64) -> (f64, f64) {
     // k = round(x · 2/π), and k mod 4 from the low mantissa bits of the rounded sum.
@@ -255,6 +255,19 @@ mod tests {
                 );
             }
         }
+        // A lane's result does not depend on its neighbours, in range or not.
+        let alone: Vec<(u64, u64)> = [0.7, -2.5, 1e6, f64::NAN]
+            .iter()
+            .map(|&x| {
+                let (s, c) = sin_cos_lanes(&[x]);
+                (s[0].to_bits(), c[0].to_bits())
+            })
+            .collect();
+        let (s, c) = sin_cos_lanes(&[0.7, -2.5, 1e6, f64::NAN]);
+        for i in 0..3 {
+            assert_eq!((s[i].to_bits(), c[i].to_bits()), alone[i], "lane {i}");
+        }
+        assert!(s[3].is_nan() && c[3].is_nan() && f64::from_bits(alone[3].0).is_nan());
         // Exact zeros and ones where the library gives them.
         assert_eq!(sin_cos_lanes(&[0.0]), ([0.0], [1.0]));
         assert!(sin_cos_lanes(&[-0.0]).0[0].is_sign_negative());
