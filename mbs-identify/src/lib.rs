@@ -7,7 +7,9 @@
 //! CSV of marker positions per run ([`Dataset::load`], [`Dataset::read_run`]). Every error
 //! names the file, the line and the field ([`DatasetError`]); nothing panics on a bad file.
 //! And the **camera**'s measurement model: a frame averages the motion over its exposure,
-//! shifted by the camera's unknown clock offset ([`Camera`]).
+//! shifted by the camera's unknown clock offset ([`Camera`]). The calibration's optimiser
+//! is [`lm`], the noise model [`noise`], and [`work`] counts a job's fits and simulations
+//! per stage and reports their rates.
 
 mod camera;
 mod dataset;
@@ -15,6 +17,7 @@ mod effect;
 pub mod lm;
 pub mod noise;
 mod rng;
+pub mod work;
 
 pub use camera::Camera;
 pub use dataset::{Dataset, DatasetError, MarkerSpec, Role, RunData, RunSpec, SCHEMA_VERSION};

@@ -23,6 +23,7 @@
 //! At the optimum the covariance is `s² (JᵀJ)⁻¹` with `s² = S / (N − k)`, mapped from
 //! internal to physical units by the delta method.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread;
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
@@ -116,8 +117,10 @@ pub struct LmOptions {
     /// Central differences (2 evaluations per column) rather than forward (1 per column);
     /// default false.
     pub central: bool,
-    /// Threads on which the Jacobian's evaluations run (default 2; 1 = serial, 0 taken as
-    /// 1). The result does not depend on it.
+    /// Threads on which the Jacobian's evaluations run (default: one per core, as
+    /// [`std::thread::available_parallelism`] reports; 1 = serial, 0 taken as 1). The
+    /// result does not depend on it. Fits run side by side share the cores: each takes a
+    /// share (two threads each still fill the gaps while one fit tries a step).
     pub threads: usize,
     /// Whether the fit returns the covariance (default true). Without it a fit that stops
     /// on its step limit or on a small step returns without evaluating the Jacobian there
@@ -139,7 +142,7 @@ impl Default for LmOptions {
             step_tolerance: 1e-6,
             fd_relative_step: 1e-4,
             central: false,
-            threads: 2,
+            threads: thread::available_parallelism().map_or(2, |n| n.get()),
             covariance: true,
         }
     }
@@ -602,36 +605,40 @@ where
         self.check((self.f)(x))
     }
 
-    /// Evaluates at every point, on up to `threads` threads; results in the order of
-    /// `points`, each independent of the thread it ran on.
+    /// Evaluates at every point, on up to `threads` threads, each taking the next point
+    /// left when it finishes one (evaluations differ in cost: a point past an event may
+    /// take twice as long); results in the order of `points`, each independent of the
+    /// thread it ran on.
     fn evaluate_all(&mut self, points: &[Vec<f64>]) -> Result<Vec<Eval>, FitError> {
         self.evaluations += points.len();
         let workers = self.options.threads.clamp(1, points.len().max(1));
         let f = self.f;
-        let share = |w: usize| -> Vec<(usize, Eval)> {
-            (w..points.len())
-                .step_by(workers)
-                .map(|i| (i, f(&points[i])))
-                .collect()
+        let next = AtomicUsize::new(0);
+        let share = || -> Vec<(usize, Eval)> {
+            let mut done = Vec::new();
+            loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(p) = points.get(i) else {
+                    return done;
+                };
+                done.push((i, f(p)));
+            }
         };
         let mut results: Vec<Option<Eval>> = (0..points.len()).map(|_| None).collect();
-        if workers == 1 {
-            for (i, e) in share(0) {
-                results[i] = Some(e);
-            }
+        let done = if workers == 1 {
+            share()
         } else {
             thread::scope(|scope| {
-                let handles: Vec<_> = (1..workers)
-                    .map(|w| scope.spawn(move || share(w)))
-                    .collect();
-                let mut shares = vec![share(0)];
+                let handles: Vec<_> = (1..workers).map(|_| scope.spawn(share)).collect();
+                let mut done = share();
                 for h in handles {
-                    shares.push(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+                    done.extend(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
                 }
-                for (i, e) in shares.into_iter().flatten() {
-                    results[i] = Some(e);
-                }
-            });
+                done
+            })
+        };
+        for (i, e) in done {
+            results[i] = Some(e);
         }
         results
             .into_iter()

@@ -340,6 +340,43 @@ fn no_parameters_is_one_evaluation() {
     assert!(fit.converged && fit.values.is_empty());
 }
 
+/// `evaluations` is the number of calls of the residual function, on any number of
+/// threads, failed calls (and the Jacobian's retries on the other side) included.
+#[test]
+fn the_evaluation_count_is_the_calls_of_the_residual_function() {
+    let data = decay_data(5);
+    for threads in [1, 3] {
+        let (calls, failures) = (AtomicUsize::new(0), AtomicUsize::new(0));
+        // The model cannot be evaluated beyond a = 2.1 (the optimum is near 2).
+        let model = |x: &[f64]| {
+            calls.fetch_add(1, Ordering::Relaxed);
+            if x[0] > 2.1 {
+                failures.fetch_add(1, Ordering::Relaxed);
+                return Err("a > 2.1".to_string());
+            }
+            Ok(data
+                .iter()
+                .map(|&(t, y)| (x[0] * (-x[1] * t).exp() - y) / SIGMA)
+                .collect())
+        };
+        let params = [
+            FreeParam::linear("a", 2.099, 0.0, 10.0, 1.0),
+            FreeParam::log("b", 0.2, 1e-3, 100.0),
+        ];
+        let options = LmOptions {
+            threads,
+            fd_relative_step: 2e-3,
+            ..LmOptions::default()
+        };
+        let fit = levenberg_marquardt(&params, model, &options).unwrap();
+        assert_eq!(
+            fit.evaluations,
+            calls.load(Ordering::Relaxed),
+            "{threads} threads"
+        );
+    }
+}
+
 #[test]
 fn the_thread_count_does_not_change_the_result() {
     let data = decay_data(3);

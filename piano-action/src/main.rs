@@ -1091,6 +1091,9 @@ fn diagnose(
             d.at_bound.join(", ")
         );
     }
+    for line in piano_action::identify::report::throughput_lines(&d.throughput) {
+        println!("{line}");
+    }
     for p in written {
         println!("wrote {}", p.display());
     }
@@ -1191,6 +1194,9 @@ fn diagnose_key_drive(
             .collect::<Vec<_>>()
             .join(", ")
     );
+    for line in piano_action::identify::report::throughput_lines(&d.throughput) {
+        println!("  {line}");
+    }
     for p in written {
         println!("wrote {}", p.display());
     }

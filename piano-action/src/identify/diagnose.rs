@@ -13,8 +13,11 @@
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
+
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
+use mbs_identify::work::{StageClock, StageWork, WorkCounter};
 use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
@@ -50,7 +53,8 @@ pub const EXPLAINED_FLOORS: f64 = 1.5;
 pub struct DiagnoseOptions {
     /// The effects tried (by default the whole pendulum library).
     pub library: Vec<&'static EffectSpec>,
-    /// Threads for the fits' Jacobians.
+    /// Cores to use (by default all): the baseline's fits use them all for their
+    /// Jacobians; the candidates' fits run side by side on them, two threads each.
     pub threads: usize,
     /// Relative tolerance of the hammer's weighed mass. The swing shows only torques
     /// relative to the inertia, and the inertia is fitted against the gravity torque
@@ -67,7 +71,7 @@ impl Default for DiagnoseOptions {
     fn default() -> Self {
         Self {
             library: PENDULUM_EFFECTS.iter().collect(),
-            threads: 2,
+            threads: std::thread::available_parallelism().map_or(2, |n| n.get()),
             mass_tolerance: MASS_TOLERANCE,
         }
     }
@@ -185,6 +189,9 @@ pub struct Diagnosis {
     pub gap: Gap,
     /// The data check.
     pub data: DataCheck,
+    /// The work of each stage, measured on this run: fits, residual evaluations and
+    /// simulations, and their rates per wall-clock second; the last entry is the `total`.
+    pub throughput: Vec<StageWork>,
     /// The traces for the report's plots (not in `report.json`).
     #[serde(skip)]
     pub traces: Vec<RunTrace>,
@@ -223,6 +230,8 @@ struct Problem<'a> {
     runs: Vec<Run>,
     noise: Ar1,
     threads: usize,
+    /// The diagnosis's fits, evaluations and simulations, counted.
+    work: &'a WorkCounter,
 }
 
 impl Problem<'_> {
@@ -260,6 +269,7 @@ impl Problem<'_> {
         let n = frames_until(r, horizon);
         let end = r.times[..n].last().copied().unwrap_or(0.0) + self.dataset.exposure_s + 0.01;
         let path = model.simulate(release, end.max(0.01));
+        self.work.add_simulations(1);
         let tracks: Vec<Vec<[f64; 2]>> = self
             .dataset
             .markers
@@ -403,6 +413,7 @@ impl Problem<'_> {
     fn fit_until(&self, start: &Setting, horizon: f64) -> Result<Fitted> {
         let free = self.free_params(start);
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
+            self.work.add_evaluation();
             let s = self.setting_of(start, x);
             let model = self.model(&s).map_err(|e| e.to_string())?;
             let mut out = Vec::new();
@@ -419,6 +430,7 @@ impl Problem<'_> {
             cost_tolerance: 1e-9,
             ..LmOptions::default()
         };
+        self.work.add_fit();
         let fit = levenberg_marquardt(&free, residuals, &options)
             .map_err(|e| PianoError::Simulation(format!("calibration: {e}")))?;
         let n = fit.residuals.len() as f64;
@@ -449,6 +461,7 @@ impl Problem<'_> {
         // stuck angle a milliradian off (see `heldout_moving_rms_m`) pull them away.
         let horizon = HELDOUT_REFIT_S;
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
+            self.work.add_evaluation();
             let pred = self.predict_until(model, r, x[0], x[1], horizon);
             Ok(self.whitened(r, &pred, horizon))
         };
@@ -459,6 +472,7 @@ impl Problem<'_> {
             cost_tolerance: 1e-9,
             ..LmOptions::default()
         };
+        self.work.add_fit();
         let fit = levenberg_marquardt(&free, residuals, &options)
             .map_err(|e| PianoError::Simulation(format!("held-out fit: {e}")))?;
         Ok(self.raw(model, r, fit.values[0], fit.values[1]))
@@ -544,6 +558,8 @@ pub fn diagnose(
     options: &DiagnoseOptions,
     progress: Progress<'_>,
 ) -> Result<Diagnosis> {
+    let work = WorkCounter::default();
+    let mut clock = StageClock::new(&work);
     progress("checking the data", 0.0);
     let (runs, noise) = prepare(dataset)?;
     let problem = Problem {
@@ -552,9 +568,11 @@ pub fn diagnose(
         runs,
         noise,
         threads: options.threads.max(1),
+        work: &work,
     };
     let sigma = noise.sigma;
     let data = DataCheck::of(dataset, &problem.runs, &noise);
+    clock.lap("data check");
     let steps = 2.0 + options.library.len() as f64;
 
     // A. The baseline: inertia, Coulomb friction, each fitted run's release and offset;
@@ -575,6 +593,7 @@ pub fn diagnose(
         }
     }
     let baseline = baseline.ok_or_else(|| PianoError::Simulation("no baseline fit".into()))?;
+    clock.lap("baseline calibration");
     let base_model = problem.model(&baseline.setting)?;
     let fit_raw = |model: &SwingModel, s: &Setting| -> Vec<Vec<f64>> {
         problem
@@ -588,6 +607,7 @@ pub fn diagnose(
         .heldout_runs()
         .map(|r| problem.refit_run(&base_model, r))
         .collect::<Result<_>>()?;
+    clock.lap("baseline held-out");
 
     // B. Where the baseline disagrees: the phases of every run, the flagged one (largest
     // gap against the noise floor, fitted runs) and the onset.
@@ -655,27 +675,70 @@ pub fn diagnose(
     // C–D. Each candidate of the library, refitted with the baseline's parameters free.
     let base_fit_rms = rms(base_fit_raw.iter().flatten().copied());
     let base_held_rms = rms(base_heldout_raw.iter().flatten().copied());
-    let mut tried: Vec<Tried> = Vec::new();
-    for (c, spec) in options.library.iter().enumerate() {
-        progress(&format!("trying {}", spec.id), (2.0 + c as f64) / steps);
-        let mut best: Option<Fitted> = None;
-        for start_values in starts_of(spec) {
-            let start = Setting {
-                effect: Some((*spec, start_values)),
-                ..baseline.setting.clone()
-            };
-            match problem.fit(&start) {
-                Ok(f) if best.as_ref().is_none_or(|b| f.fit.rss < b.fit.rss) => best = Some(f),
-                _ => {}
+    // Every start of every candidate, then each candidate's held-out refits, side by
+    // side on the cores, each fit's Jacobian on two threads so that a fit trying a step,
+    // or the last one left, leaves no core idle; the results are taken in the library's
+    // order whatever finished first.
+    let library = &options.library;
+    progress(&format!("trying {} effects", library.len()), 2.0 / steps);
+    let width = problem.threads;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(width)
+        .build()
+        .map_err(|e| PianoError::Simulation(format!("the diagnosis's threads: {e}")))?;
+    let side_by_side = Problem {
+        runs: problem.runs.clone(),
+        threads: width.min(2),
+        ..problem
+    };
+    let jobs: Vec<(usize, Vec<f64>)> = library
+        .iter()
+        .enumerate()
+        .flat_map(|(c, spec)| starts_of(spec).into_iter().map(move |v| (c, v)))
+        .collect();
+    let fits: Vec<Result<Fitted>> = pool.install(|| {
+        jobs.par_iter()
+            .with_max_len(1)
+            .map(|(c, values)| {
+                side_by_side.fit(&Setting {
+                    effect: Some((library[*c], values.clone())),
+                    ..baseline.setting.clone()
+                })
+            })
+            .collect()
+    });
+    let mut best: Vec<Option<Fitted>> = library.iter().map(|_| None).collect();
+    for ((c, _), f) in jobs.iter().zip(fits) {
+        match f {
+            Ok(f) if best[*c].as_ref().is_none_or(|b| f.fit.rss < b.fit.rss) => {
+                best[*c] = Some(f);
             }
+            _ => {}
         }
-        let Some(fitted) = best else { continue };
-        let model = problem.model(&fitted.setting)?;
-        let c_fit_raw = fit_raw(&model, &fitted.setting);
-        let c_held_raw: Vec<Vec<f64>> = problem
-            .heldout_runs()
-            .map(|r| problem.refit_run(&model, r))
-            .collect::<Result<_>>()?;
+    }
+    type Judged = Option<(Fitted, SwingModel, Vec<Vec<f64>>, Vec<Vec<f64>>)>;
+    let judged: Vec<Result<Judged>> = pool.install(|| {
+        best.into_par_iter()
+            .with_max_len(1)
+            .map(|fitted| {
+                let Some(fitted) = fitted else {
+                    return Ok(None);
+                };
+                let model = side_by_side.model(&fitted.setting)?;
+                let c_fit_raw = fit_raw(&model, &fitted.setting);
+                let c_held_raw: Vec<Vec<f64>> = side_by_side
+                    .heldout_runs()
+                    .map(|r| side_by_side.refit_run(&model, r))
+                    .collect::<Result<_>>()?;
+                Ok(Some((fitted, model, c_fit_raw, c_held_raw)))
+            })
+            .collect()
+    });
+    let mut tried: Vec<Tried> = Vec::new();
+    for (spec, judged) in library.iter().zip(judged) {
+        let Some((fitted, model, c_fit_raw, c_held_raw)) = judged? else {
+            continue;
+        };
         // The held-out gap while the swing is large: where the hammer makes its last
         // small swings and sticks hangs on whether one reversal falls just inside or
         // just outside the static friction, a threshold a model right to a per cent can
@@ -773,6 +836,7 @@ pub fn diagnose(
             candidate: cand,
         });
     }
+    clock.lap("candidates: fits and held-out");
     progress("writing the diagnosis", 1.0);
 
     // E. The decision.
@@ -919,6 +983,9 @@ pub fn diagnose(
         &baseline.setting,
         corrected_model.zip(corrected.map(|t| &t.fitted.setting)),
     )?;
+    clock.lap("report");
+    let mut throughput = clock.stages();
+    throughput.push(clock.total());
     Ok(Diagnosis {
         decision,
         summary,
@@ -935,6 +1002,7 @@ pub fn diagnose(
             .collect(),
         gap,
         data,
+        throughput,
         traces,
     })
 }

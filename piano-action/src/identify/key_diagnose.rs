@@ -30,12 +30,14 @@
 //! whatever their BIC.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
 
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
+use mbs_identify::work::{StageClock, StageWork, WorkCounter};
 use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
@@ -46,6 +48,7 @@ use super::diagnose::{
     NamedEffect, Progress,
 };
 use super::key_drive::{EXPERIMENT, Phase, marker_tracks_of, sequence, simulate_effect};
+use super::recent::{Recent, RecentKey};
 use crate::ModelKind;
 use crate::error::{PianoError, Result};
 use crate::params::ActionParams;
@@ -138,8 +141,9 @@ pub const SCREEN_ITERATIONS: usize = 4;
 pub struct KeyDiagnoseOptions {
     /// The effects tried (by default the whole action family).
     pub library: Vec<&'static EffectSpec>,
-    /// Threads: the baseline fits' Jacobians, the screening's points and the refits share
-    /// them (by default one per core).
+    /// Cores to use (by default all): the baseline's three starts, the screening's points
+    /// and the refits run side by side on them, each fit's Jacobian on a share of them
+    /// (two threads at least); a fit alone uses them all for its Jacobian.
     pub threads: usize,
     /// The model.
     pub kind: ModelKind,
@@ -303,6 +307,9 @@ pub struct KeyDriveDiagnosis {
     pub data: DataCheck,
     /// Where the time went (stage, s).
     pub timing: Vec<(String, f64)>,
+    /// The work of each stage, measured on this run: fits, residual evaluations and
+    /// simulations, and their rates per wall-clock second; the last entry is the `total`.
+    pub throughput: Vec<StageWork>,
     /// Traces for the plots.
     #[serde(skip)]
     pub traces: Vec<MarkerTrace>,
@@ -428,6 +435,82 @@ struct Problem<'a> {
     /// The end of the rise (s): the file's action first reaching the string in the first
     /// fitted run.
     rise_end: f64,
+    /// The action felts' stiffnesses that `felt_k_scale` multiplies: their paths and the
+    /// file's values (listed once; listing reads the parameter file's text).
+    felt_k: &'a [(String, f64)],
+    /// The diagnosis's fits, evaluations and simulations, counted.
+    work: &'a WorkCounter,
+}
+
+/// The paths and values of the action felts' stiffnesses in `params` that `felt_k_scale`
+/// multiplies: every contact's `k` but the front rail's (an effect of the library) and the
+/// hammer–string law's (not an action felt).
+fn felt_stiffnesses(params: &ActionParams) -> Result<Vec<(String, f64)>> {
+    Ok(params
+        .parameter_list(crate::params::DEFAULT_PARAMS_TOML)?
+        .into_iter()
+        .filter(|info| {
+            let path = &info.path;
+            path.starts_with("contacts.")
+                && path.ends_with(".k")
+                && path != "contacts.front_rail.k"
+                && path != "contacts.hammer_string.k"
+        })
+        .map(|info| (info.path, info.value))
+        .collect())
+}
+
+/// `params` with each `(path, value)` set in turn, as [`ActionParams::set_parameter`]
+/// would leave them, checked once at the end rather than after each value (each check
+/// converts the whole set; a dozen of them cost more than the rest of making an
+/// evaluation's parameters). A path that does not name a number of the set is set by
+/// [`ActionParams::set_parameter`], which says why it cannot be.
+fn with_values(params: &ActionParams, values: &[(&str, f64)]) -> Result<ActionParams> {
+    let encode =
+        |e: serde_json::Error| PianoError::params(String::new(), format!("cannot encode: {e}"));
+    let mut tree = serde_json::to_value(params).map_err(encode)?;
+    for &(path, value) in values {
+        let pointer = format!("/{}", path.replace('.', "/"));
+        let slot = tree.pointer_mut(&pointer).filter(|slot| slot.is_f64());
+        let number = serde_json::Number::from_f64(value);
+        let (Some(slot), Some(number)) = (slot, number) else {
+            // Named in the error (unknown path, not finite, or not a plain number).
+            let mut p = params.clone();
+            for &(path, value) in values {
+                p.set_parameter(path, value)?;
+            }
+            return Ok(p);
+        };
+        *slot = serde_json::Value::Number(number);
+    }
+    let updated: ActionParams = serde_json::from_value(tree)
+        .map_err(|e| PianoError::params(String::new(), format!("cannot take the values: {e}")))?;
+    updated.validate()?;
+    Ok(updated)
+}
+
+/// A run simulated and its markers' world positions at the simulation's output times,
+/// before the camera films them.
+struct Tracked {
+    /// The parameters it ran with.
+    params: ActionParams,
+    input: Input,
+    /// Its last frame time taken into account (s).
+    last: f64,
+    sim: crate::simulate::Run,
+    times: Vec<f64>,
+    /// Per marker (m).
+    tracks: Vec<Vec<[f64; 2]>>,
+}
+
+/// The markers' world positions (m) at a simulation's output times (s).
+type MarkerTracks = (Vec<f64>, Vec<Vec<[f64; 2]>>);
+
+/// A simulation of a fitted run told apart by the run's index, its release height and
+/// the setting's physics (the calibrated values and the effect's), bit for bit.
+fn recent_key(run: usize, height: f64, s: &Setting) -> RecentKey {
+    let effect = s.effect.iter().flat_map(|e| e.values.iter());
+    RecentKey::new(run, std::iter::once(&height).chain(&s.cal).chain(effect))
 }
 
 /// A simulated run: predicted observations, the model's events and its phases.
@@ -454,28 +537,27 @@ impl<'a> Problem<'a> {
             kind: self.kind,
             threads: self.threads,
             rise_end: self.rise_end,
+            felt_k: self.felt_k,
+            work: self.work,
         }
     }
 
     /// The parameter file with the calibrated values of `cal`.
     fn params_of(&self, cal: &[f64; 5]) -> Result<ActionParams> {
-        let mut p = self.params.clone();
-        let list = self
-            .params
-            .parameter_list(crate::params::DEFAULT_PARAMS_TOML)?;
-        for info in &list {
-            let path = &info.path;
-            if path.starts_with("contacts.")
-                && path.ends_with(".k")
-                && path != "contacts.front_rail.k"
-                && path != "contacts.hammer_string.k"
-            {
-                p.set_parameter(path, info.value * cal[0])?;
-            }
-        }
-        for (j, (path, _)) in CALIBRATED.iter().enumerate().skip(1) {
-            p.set_parameter(path, cal[j])?;
-        }
+        // The felts first: the back-check's own stiffness is one of them, set last.
+        let values: Vec<(&str, f64)> = self
+            .felt_k
+            .iter()
+            .map(|(path, value)| (path.as_str(), value * cal[0]))
+            .chain(
+                CALIBRATED
+                    .iter()
+                    .zip(cal)
+                    .skip(1)
+                    .map(|((p, _), v)| (*p, *v)),
+            )
+            .collect();
+        let mut p = with_values(self.params, &values)?;
         // A fit differences the simulation: its error must lie well under the 1 %
         // parameter steps' effect.
         p.numerics.relative_tolerance = p.numerics.relative_tolerance.min(FIT_RTOL);
@@ -508,6 +590,34 @@ impl<'a> Problem<'a> {
         offset: f64,
         until: f64,
     ) -> Result<Simulated> {
+        let t = self.track_until(s, r, height, until)?;
+        let (frames, predicted) = self.film(r, &t.times, &t.tracks, offset);
+        let phases = sequence(
+            &t.params,
+            self.kind,
+            &t.input,
+            &t.sim,
+            t.last,
+            s.effect.as_ref(),
+        )?;
+        Ok(Simulated {
+            height,
+            offset,
+            predicted,
+            frames,
+            events: t
+                .sim
+                .events
+                .iter()
+                .map(|e| (e.name.to_string(), e.time_s))
+                .collect(),
+            phases,
+        })
+    }
+
+    /// Run `r` simulated under `s` from `height` as far as its frames before `until` (s)
+    /// need, and its markers tracked.
+    fn track_until(&self, s: &Setting, r: &Run, height: f64, until: f64) -> Result<Tracked> {
         let p = self.params_of(&s.cal)?;
         let input = Input::MassDrop {
             mass_kg: self.mass_kg,
@@ -516,7 +626,8 @@ impl<'a> Problem<'a> {
         let last = r.times.last().copied().unwrap_or(0.0).min(until);
         let end = last + self.dataset.exposure_s + OFFSET_TOLERANCE_S + 1e-3;
         let sim = simulate_effect(&p, self.kind, &input, end, s.effect.as_ref())?;
-        let (sim_t, tracks) = marker_tracks_of(
+        self.work.add_simulations(1);
+        let (times, tracks) = marker_tracks_of(
             &p,
             self.kind,
             &input,
@@ -524,6 +635,25 @@ impl<'a> Problem<'a> {
             &self.dataset.markers,
             s.effect.as_ref(),
         )?;
+        Ok(Tracked {
+            params: p,
+            input,
+            last,
+            sim,
+            times,
+            tracks,
+        })
+    }
+
+    /// What the camera with clock `offset` films of the markers' `tracks` (at `times`)
+    /// in the frames of run `r`: per marker and frame, and the predicted observations.
+    fn film(
+        &self,
+        r: &Run,
+        times: &[f64],
+        tracks: &[Vec<[f64; 2]>],
+        offset: f64,
+    ) -> (Vec<Vec<[f64; 2]>>, Vec<f64>) {
         let camera = Camera {
             exposure_s: self.dataset.exposure_s,
             offset_s: offset,
@@ -535,7 +665,7 @@ impl<'a> Problem<'a> {
                     .iter()
                     .map(|&t| {
                         camera
-                            .frame(t, |u| Some(super::key_drive::at(&sim_t, track, u)))
+                            .frame(t, |u| Some(super::key_drive::at(times, track, u)))
                             .unwrap_or(track[0])
                     })
                     .collect()
@@ -546,19 +676,32 @@ impl<'a> Problem<'a> {
             .iter()
             .map(|o| frames[o.marker][o.frame][o.axis])
             .collect();
-        let phases = sequence(&p, self.kind, &input, &sim, last, s.effect.as_ref())?;
-        Ok(Simulated {
-            height,
-            offset,
-            predicted,
-            frames,
-            events: sim
-                .events
-                .iter()
-                .map(|e| (e.name.to_string(), e.time_s))
-                .collect(),
-            phases,
-        })
+        (frames, predicted)
+    }
+
+    /// The predicted observations of run `r` (the `run`-th) as [`Problem::simulate_until`]
+    /// gives them, for a fit: a simulation `recent` holds is filmed again, not run again.
+    #[allow(clippy::too_many_arguments)]
+    fn predict_until(
+        &self,
+        recent: &Recent<MarkerTracks>,
+        s: &Setting,
+        (run, r): (usize, &Run),
+        height: f64,
+        offset: f64,
+        until: f64,
+    ) -> Result<Vec<f64>> {
+        let key = recent_key(run, height, s);
+        let tracks = match recent.get(&key) {
+            Some(tracks) => tracks,
+            None => {
+                let t = self.track_until(s, r, height, until)?;
+                let tracks = Arc::new((t.times, t.tracks));
+                recent.put(key, tracks.clone());
+                tracks
+            }
+        };
+        Ok(self.film(r, &tracks.0, &tracks.1, offset).1)
     }
 
     fn whitened(&self, r: &Run, predicted: &[f64]) -> Vec<f64> {
@@ -723,17 +866,27 @@ impl<'a> Problem<'a> {
             f64::INFINITY
         };
         let free = self.free_params(start, stage)?;
+        // The rise frees each run's release height and clock: a Jacobian column that
+        // moves one of them reuses the other runs' simulations, and the clock's its own.
+        let runs = self.fit_runs().count();
+        let recent = Recent::new(if stage == Stage::Rise {
+            (free.len() + 1) * runs
+        } else {
+            0
+        });
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
+            self.work.add_evaluation();
             let s = self.setting_of(start, x, stage);
             let mut out = Vec::new();
-            for (r, (h, off)) in self.fit_runs().zip(&s.runs) {
-                let sim = self
-                    .simulate_until(&s, r, *h, *off, horizon)
+            for (i, (r, (h, off))) in self.fit_runs().zip(&s.runs).enumerate() {
+                let predicted = self
+                    .predict_until(&recent, &s, (i, r), *h, *off, horizon)
                     .map_err(|e| e.to_string())?;
-                out.extend(self.whitened_until(r, &sim.predicted, horizon));
+                out.extend(self.whitened_until(r, &predicted, horizon));
             }
             Ok(out)
         };
+        self.work.add_fit();
         let options = LmOptions {
             max_iterations: iterations,
             covariance,
@@ -764,10 +917,16 @@ impl<'a> Problem<'a> {
                 1e-4,
             ),
         ];
+        // The clock's Jacobian column films the point's simulation again.
+        let recent = Recent::new(free.len() + 1);
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
-            let sim = self.simulate(s, r, x[0], x[1]).map_err(|e| e.to_string())?;
-            Ok(self.whitened(r, &sim.predicted))
+            self.work.add_evaluation();
+            let predicted = self
+                .predict_until(&recent, s, (0, r), x[0], x[1], f64::INFINITY)
+                .map_err(|e| e.to_string())?;
+            Ok(self.whitened(r, &predicted))
         };
+        self.work.add_fit();
         // Its values alone are wanted.
         let options = LmOptions {
             covariance: false,
@@ -778,6 +937,14 @@ impl<'a> Problem<'a> {
         let sim = self.simulate(s, r, fit.values[0], fit.values[1])?;
         Ok((raw(r, &sim.predicted), sim))
     }
+}
+
+/// Threads of the Jacobian of each of `tasks` fits run side by side on `width` cores:
+/// the cores shared out, and two at least (on two cores or more), so that a core does
+/// not idle while a fit tries a step or while the last fits finish alone. The result does
+/// not depend on it.
+fn threads_each(width: usize, tasks: usize) -> usize {
+    width.div_ceil(tasks.max(1)).max(2).min(width.max(1))
 }
 
 /// A run's release height, free within [`HEIGHT_TOLERANCE_M`] of the stated one (not
@@ -946,14 +1113,8 @@ pub fn diagnose_key_drive(
     options: &KeyDiagnoseOptions,
     progress: Progress<'_>,
 ) -> Result<KeyDriveDiagnosis> {
-    let clock = Instant::now();
-    let mut timing: Vec<(String, f64)> = Vec::new();
-    let mut lap = |name: &str, since: &mut f64| {
-        let now = clock.elapsed().as_secs_f64();
-        timing.push((name.to_string(), now - *since));
-        *since = now;
-    };
-    let mut since = 0.0;
+    let work = WorkCounter::default();
+    let mut clock = StageClock::new(&work);
     if dataset.experiment != EXPERIMENT {
         return Err(PianoError::File {
             path: dataset.dir.join("dataset.json"),
@@ -965,6 +1126,7 @@ pub fn diagnose_key_drive(
     }
     progress("checking the data", 0.0);
     let (runs, noise, mass_kg) = prepare(dataset)?;
+    let felt_k = felt_stiffnesses(params)?;
     let mut problem = Problem {
         params,
         dataset,
@@ -974,10 +1136,12 @@ pub fn diagnose_key_drive(
         kind: options.kind,
         threads: options.threads.max(1),
         rise_end: f64::INFINITY,
+        felt_k: &felt_k,
+        work: &work,
     };
     let sigma = noise.sigma;
     let data = DataCheck::of(dataset, &problem.runs, &noise);
-    lap("data check", &mut since);
+    clock.lap("data check");
     let steps = 2.0 + options.library.len() as f64;
 
     // A. The baseline: calibrated on the rise (the frames before the file's action first
@@ -1004,14 +1168,36 @@ pub fn diagnose_key_drive(
     };
     problem.rise_end = rise_end;
     let problem = problem;
-    let mut baseline: Option<Fitted> = None;
-    for scale in [1.0, 0.85, 1.15] {
-        let start = Setting {
+    let starts: Vec<Setting> = [1.0, 0.85, 1.15]
+        .into_iter()
+        .map(|scale| Setting {
             cal: [scale, file[1], file[2] / scale, file[3], file[4]],
             effect: None,
             runs: problem.fit_runs().map(|r| (r.release, 0.0)).collect(),
-        };
-        match problem.fit(&start, Stage::Rise) {
+        })
+        .collect();
+    // The starts side by side, the cores shared among them: a lone fit leaves a core
+    // idle while it tries a step.
+    let starting = Problem {
+        threads: problem.threads.div_ceil(starts.len()),
+        ..problem.shallow()
+    };
+    let rise_fits: Vec<Result<Fitted>> = if problem.threads > 1 {
+        std::thread::scope(|scope| {
+            let fits: Vec<_> = starts
+                .iter()
+                .map(|start| scope.spawn(|| starting.fit(start, Stage::Rise)))
+                .collect();
+            fits.into_iter()
+                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect()
+        })
+    } else {
+        starts.iter().map(|s| problem.fit(s, Stage::Rise)).collect()
+    };
+    let mut baseline: Option<Fitted> = None;
+    for f in rise_fits {
+        match f {
             Ok(f) if baseline.as_ref().is_none_or(|b| f.fit.rss < b.fit.rss) => {
                 baseline = Some(f);
             }
@@ -1022,7 +1208,7 @@ pub fn diagnose_key_drive(
         PianoError::Simulation("the baseline could not be fitted from any start".into())
     })?;
     let baseline = problem.fit(&rise.setting, Stage::Whole)?;
-    lap("baseline calibration", &mut since);
+    clock.lap("baseline calibration");
 
     // The baseline everywhere: fitted runs at their fitted release, held-out refitted.
     let evaluate = |s: &Setting| -> Result<Vec<(Vec<f64>, Simulated)>> {
@@ -1041,7 +1227,7 @@ pub fn diagnose_key_drive(
         Ok(out)
     };
     let base_eval = evaluate(&baseline.setting)?;
-    lap("baseline held-out", &mut since);
+    clock.lap("baseline held-out");
     let fit_idx: Vec<usize> = (0..problem.runs.len())
         .filter(|&i| problem.runs[i].role == Role::Fit)
         .collect();
@@ -1107,14 +1293,14 @@ pub fn diagnose_key_drive(
         .iter()
         .map(|ph| window_rms(r0, &base_eval[f0].0, ph.from_s, ph.to_s, None) / sigma)
         .fold(0.0, f64::max);
-    lap("localisation", &mut since);
+    clock.lap("localisation");
 
     // C. Screening, every effect's grid at once on every core: at each point the rise is
     // calibrated again with the effect in (an effect that acts in the rise would
     // otherwise hide in the calibration), the back-check's values refitted briefly (the
-    // baseline has had the chance to hide the effect in them). Each point is serial; the
-    // points share the cores, and the results are taken in grid order whatever finished
-    // first.
+    // baseline has had the chance to hide the effect in them). The points share the
+    // cores (see `threads_each`), and the results are taken in grid order whatever
+    // finished first.
     struct Tried {
         spec: &'static EffectSpec,
         fitted: Fitted,
@@ -1132,42 +1318,45 @@ pub fn diagnose_key_drive(
         .num_threads(width)
         .build()
         .map_err(|e| PianoError::Simulation(format!("the diagnosis's threads: {e}")))?;
-    let serial = Problem {
-        threads: 1,
+    let side_by_side = |tasks: usize| Problem {
+        threads: threads_each(width, tasks),
         ..problem.shallow()
     };
-    let screen_point =
-        |spec: &'static EffectSpec, values: &[f64]| -> (Option<(f64, Setting)>, f64) {
-            let clock = Instant::now();
-            let point = (|| {
-                let start = Setting {
-                    effect: Some(ActionEffect {
-                        spec,
-                        values: values.to_vec(),
-                    }),
-                    ..rise.setting.clone()
-                };
-                let recalibrated = serial
-                    .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS, false)
-                    .ok()?;
-                let mut s = recalibrated.setting;
-                for j in RISE_HELD {
-                    s.cal[j] = baseline.setting.cal[j];
-                }
-                let whole = serial
-                    .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS, false)
-                    .ok()?;
-                Some((whole.fit.rss, whole.setting))
-            })();
-            (point, clock.elapsed().as_secs_f64())
-        };
+    let screen_point = |serial: &Problem<'_>,
+                        spec: &'static EffectSpec,
+                        values: &[f64]|
+     -> (Option<(f64, Setting)>, f64) {
+        let clock = Instant::now();
+        let point = (|| {
+            let start = Setting {
+                effect: Some(ActionEffect {
+                    spec,
+                    values: values.to_vec(),
+                }),
+                ..rise.setting.clone()
+            };
+            let recalibrated = serial
+                .fit_limited(&start, Stage::Rise, SCREEN_RISE_ITERATIONS, false)
+                .ok()?;
+            let mut s = recalibrated.setting;
+            for j in RISE_HELD {
+                s.cal[j] = baseline.setting.cal[j];
+            }
+            let whole = serial
+                .fit_limited(&s, Stage::Whole, SCREEN_ITERATIONS, false)
+                .ok()?;
+            Some((whole.fit.rss, whole.setting))
+        })();
+        (point, clock.elapsed().as_secs_f64())
+    };
     let library = &options.library;
     let screen_all = |jobs: &[(usize, Vec<f64>)]| -> Vec<(Option<(f64, Setting)>, f64)> {
+        let serial = side_by_side(jobs.len());
         pool.install(|| {
             // One point a task, so that a core that finishes early takes the next.
             jobs.par_iter()
                 .with_max_len(1)
-                .map(|(c, v)| screen_point(library[*c], v))
+                .map(|(c, v)| screen_point(&serial, library[*c], v))
                 .collect()
         })
     };
@@ -1208,7 +1397,7 @@ pub fn diagnose_key_drive(
         points[*c].push(p);
         screen_s[*c] += secs;
     }
-    lap("candidates: screening", &mut since);
+    clock.lap("candidates: screening");
 
     // D. The effects whose best point beats the baseline, refitted with the effect's
     // parameters and the back-check's values free, side by side.
@@ -1255,6 +1444,7 @@ pub fn diagnose_key_drive(
         (2.0 + 0.5 * library.len() as f64) / steps,
     );
     type Refit = Option<(Fitted, Vec<Vec<f64>>)>;
+    let serial = side_by_side(starts.len());
     let refits: Vec<(Result<Refit>, f64)> = pool.install(|| {
         starts
             .par_iter()
@@ -1281,6 +1471,7 @@ pub fn diagnose_key_drive(
             })
             .collect()
     });
+    clock.lap("candidates: refits");
     let mut tried: Vec<Tried> = Vec::new();
     for ((c, _), (refit, refit_s)) in starts.iter().zip(refits) {
         let spec = library[*c];
@@ -1420,7 +1611,7 @@ pub fn diagnose_key_drive(
             format!("dropped: {}", t.fails.join("; "))
         };
     }
-    lap("candidates: refits and held-out", &mut since);
+    clock.lap("candidates: held-out");
     progress("writing the diagnosis", 1.0);
 
     // E. The decision: the lowest BIC of the kept; rivals within the BIC margin, or
@@ -1636,7 +1827,9 @@ pub fn diagnose_key_drive(
         models.push(("corrected", after_setting, after_eval));
     }
     let replay = replay_data(&problem, &models).ok();
-    lap("report", &mut since);
+    clock.lap("report");
+    let mut throughput = clock.stages();
+    throughput.push(clock.total());
     Ok(KeyDriveDiagnosis {
         experiment: EXPERIMENT.to_string(),
         decision,
@@ -1668,7 +1861,12 @@ pub fn diagnose_key_drive(
         onset,
         events: base_eval[f0].1.events.clone(),
         data,
-        timing,
+        timing: throughput
+            .iter()
+            .filter(|s| s.stage != "total")
+            .map(|s| (s.stage.clone(), s.wall_s))
+            .collect(),
+        throughput,
         traces,
         replay,
     })
@@ -1842,6 +2040,102 @@ fn onset_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A fit's evaluation that moves only a run's clock films the simulation it already
+    /// has: the same predictions, bit for bit, as simulating again, and one simulation
+    /// counted where two were asked for.
+    #[test]
+    fn an_evaluation_that_moves_only_the_clock_reuses_the_simulation() {
+        use super::super::key_drive::{KeyDriveOptions, synthesize};
+        let params = ActionParams::reference();
+        let short = KeyDriveOptions {
+            release_heights_m: vec![0.0],
+            duration_s: 0.05,
+            ..KeyDriveOptions::default()
+        };
+        let (dataset, runs, _) = synthesize(&params, &short).expect("synthesises");
+        let dir = std::env::temp_dir().join(format!("piano-kdiag-recent-{}", std::process::id()));
+        dataset.write(&dir, &runs).expect("writes");
+        let dataset = Dataset::load(&dir).expect("reads back");
+        let (runs, noise, mass_kg) = prepare(&dataset).expect("prepares");
+        let felt_k = felt_stiffnesses(&params).expect("lists");
+        let work = WorkCounter::default();
+        let problem = Problem {
+            params: &params,
+            dataset: &dataset,
+            runs,
+            noise,
+            mass_kg,
+            kind: ModelKind::Double,
+            threads: 1,
+            rise_end: f64::INFINITY,
+            felt_k: &felt_k,
+            work: &work,
+        };
+        let r = &problem.runs[0];
+        let s = Setting {
+            cal: problem.file_cal().expect("the file's values"),
+            effect: None,
+            runs: vec![(0.0, 0.0)],
+        };
+        let recent = Recent::new(2);
+        let predict = |height: f64, offset: f64| {
+            problem
+                .predict_until(&recent, &s, (0, r), height, offset, f64::INFINITY)
+                .expect("predicts")
+        };
+        let first = predict(0.0, 0.0);
+        let shifted = predict(0.0, 2e-4);
+        assert_eq!(work.count().simulations, 1);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let again = |offset: f64| problem.simulate(&s, r, 0.0, offset).expect("simulates");
+        assert_eq!(bits(&first), bits(&again(0.0).predicted));
+        assert_eq!(bits(&shifted), bits(&again(2e-4).predicted));
+        assert_ne!(bits(&first), bits(&shifted));
+        // Another release height is another simulation.
+        predict(1e-3, 0.0);
+        assert_eq!(work.count().simulations, 4);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// An evaluation's parameters set at once are those set one by one, bit for bit; a
+    /// value the set cannot take is refused, naming it.
+    #[test]
+    fn values_set_at_once_are_values_set_one_by_one() {
+        let params = ActionParams::reference();
+        let felt = felt_stiffnesses(&params).expect("lists");
+        assert!(felt.iter().any(|(p, _)| p == "contacts.backcheck.k"));
+        assert!(!felt.iter().any(|(p, _)| p == "contacts.front_rail.k"));
+        let file: Vec<f64> = CALIBRATED
+            .iter()
+            .map(|(p, _)| params.parameter(p).unwrap_or(1.0))
+            .collect();
+        for scale in [1.0, 0.87, 1.3] {
+            let values: Vec<(&str, f64)> = felt
+                .iter()
+                .map(|(p, v)| (p.as_str(), v * scale))
+                .chain(
+                    CALIBRATED
+                        .iter()
+                        .zip(&file)
+                        .skip(1)
+                        .map(|((p, _), v)| (*p, v / scale)),
+                )
+                .collect();
+            let mut one_by_one = params.clone();
+            for &(path, v) in &values {
+                one_by_one.set_parameter(path, v).expect("sets");
+            }
+            assert_eq!(with_values(&params, &values).expect("sets"), one_by_one);
+        }
+        let bad = with_values(&params, &[("hammer.mass_g", -1.0)]).unwrap_err();
+        assert!(bad.to_string().contains("hammer.mass_g"), "{bad}");
+        let unknown = with_values(&params, &[("contacts.nowhere.k", 1.0)]).unwrap_err();
+        assert!(
+            unknown.to_string().contains("contacts.nowhere.k"),
+            "{unknown}"
+        );
+    }
 
     fn dataset_with(markers: &[(&str, &str, [f64; 2])]) -> Dataset {
         Dataset {

@@ -7,7 +7,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::key_diagnose::KeyDriveDiagnosis;
-use super::report::{FILES, calibrated_table, check_out_dir, data_items, generator_mark};
+use super::report::{
+    FILES, calibrated_table, check_out_dir, data_items, generator_mark, throughput_html,
+    throughput_markdown,
+};
 use crate::error::{PianoError, Result};
 use crate::validate::page::PAGE_STYLE;
 use crate::validate::svg::{Axis, Chart, Corner, Mark, Series, escape};
@@ -204,9 +207,7 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
         "\nThe baseline calibration frees {}.\n\n## Where the time went\n",
         d.calibration_frees.join(", ")
     );
-    for (stage, t) in &d.timing {
-        let _ = writeln!(s, "- {stage}: {t:.1} s");
-    }
+    s.push_str(&throughput_markdown(&d.throughput));
     s
 }
 
@@ -415,9 +416,8 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     s.push_str(&calibrated_table(&d.rise_calibrated));
     s.push_str("<h2>Data and time</h2>\n<ul>\n");
     s.push_str(&data_items(&d.data));
-    for (stage, t) in &d.timing {
-        let _ = writeln!(s, "<li>{}: {t:.1} s</li>", escape(stage));
-    }
-    s.push_str("</ul>\n</body>\n</html>\n");
+    s.push_str("</ul>\n");
+    s.push_str(&throughput_html(&d.throughput));
+    s.push_str("</body>\n</html>\n");
     s
 }

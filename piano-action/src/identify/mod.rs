@@ -11,6 +11,7 @@ pub mod effects;
 pub mod key_diagnose;
 pub mod key_drive;
 pub mod key_report;
+mod recent;
 pub mod report;
 pub mod swing_model;
 pub mod synth;

@@ -5,6 +5,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use mbs_identify::work::StageWork;
+
 use super::diagnose::Diagnosis;
 use crate::error::{PianoError, Result};
 use crate::validate::page::PAGE_STYLE;
@@ -174,6 +176,8 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
             r.id, r.role, r.frames, r.lost_frames, r.outlier_frames
         );
     }
+    let _ = writeln!(s, "\n## Where the time went\n");
+    s.push_str(&throughput_markdown(&d.throughput));
     s
 }
 
@@ -416,10 +420,69 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
     }
     s.push_str("</tbody></table>\n<h2>Calibrated</h2>\n");
     s.push_str(&calibrated_table(&d.calibrated));
-    s.push_str("<h2>Data</h2>\n<ul>\n");
+    s.push_str("<h2>Data and time</h2>\n<ul>\n");
     s.push_str(&data_items(&d.data));
-    s.push_str("</ul>\n</body>\n</html>\n");
+    s.push_str("</ul>\n");
+    s.push_str(&throughput_html(&d.throughput));
+    s.push_str("</body>\n</html>\n");
     s
+}
+
+/// The work of each stage and its rates as a Markdown table.
+pub(super) fn throughput_markdown(stages: &[StageWork]) -> String {
+    let mut s = String::from(
+        "| stage | wall (s) | fits | evaluations | simulations | fits/s | simulations/s |\n\
+         |---|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for w in stages {
+        let _ = writeln!(
+            s,
+            "| {} | {:.1} | {} | {} | {} | {:.2} | {:.1} |",
+            w.stage,
+            w.wall_s,
+            w.fits,
+            w.evaluations,
+            w.simulations,
+            w.fits_per_s,
+            w.simulations_per_s
+        );
+    }
+    s
+}
+
+/// The work of each stage and its rates as an HTML table.
+pub(super) fn throughput_html(stages: &[StageWork]) -> String {
+    let mut s = String::from(
+        "<table><thead><tr><th>stage</th><th>wall (s)</th><th>fits</th><th>evaluations</th>\
+         <th>simulations</th><th>fits/s</th><th>simulations/s</th></tr></thead><tbody>\n",
+    );
+    for w in stages {
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td class=\"num\">{:.1}</td><td class=\"num\">{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{:.2}</td>\
+             <td class=\"num\">{:.1}</td></tr>",
+            escape(&w.stage),
+            w.wall_s,
+            w.fits,
+            w.evaluations,
+            w.simulations,
+            w.fits_per_s,
+            w.simulations_per_s
+        );
+    }
+    s.push_str("</tbody></table>\n");
+    s
+}
+
+/// The stages that did fits, and the total, a line each, for a terminal (see
+/// [`StageWork::line`]).
+pub fn throughput_lines(stages: &[StageWork]) -> Vec<String> {
+    stages
+        .iter()
+        .filter(|w| w.fits > 0 || w.stage == "total")
+        .map(StageWork::line)
+        .collect()
 }
 
 /// The calibrated values as an HTML table.
