@@ -128,8 +128,10 @@ pub(crate) struct IterationMatrix {
     /// The active block `J_AA`, column-major, then work space for a solve.
     block: Vec<f64>,
     work: Vec<f64>,
-    /// Whether the Jacobian changed since `active` was found.
+    /// Whether the Jacobian changed since `active` and `coupled` were found.
     stale: bool,
+    /// Columns the Jacobian's maker knows to be zero (not searched).
+    known_zero: Vec<bool>,
 }
 
 impl IterationMatrix {
@@ -145,13 +147,23 @@ impl IterationMatrix {
             block: vec![0.0; n * n],
             work: vec![0.0; n],
             stale: true,
+            known_zero: vec![false; n],
         }
     }
 
-    /// Tells the matrix that the Jacobian changed: its zero columns are looked for again at
-    /// the next factorisation.
-    pub fn jacobian_changed(&mut self) {
+    /// Tells the matrix that the Jacobian changed: its zero columns, and the passive
+    /// states' coupling rows, are looked for again at the next factorisation. The columns
+    /// flagged in `known_zero` (when it is as long as the state) are zero already, as the
+    /// Jacobian's maker knows, and are not searched (a string's modal amplitudes: 96 of
+    /// its 106 columns).
+    pub fn jacobian_changed(&mut self, known_zero: &[bool]) {
         self.stale = true;
+        self.known_zero.clear();
+        if known_zero.len() == self.n {
+            self.known_zero.extend_from_slice(known_zero);
+        } else {
+            self.known_zero.resize(self.n, false);
+        }
     }
 
     /// Factors `I − c J` (J column-major, n × n). Returns false when singular.
@@ -161,10 +173,19 @@ impl IterationMatrix {
             self.active.clear();
             self.passive.clear();
             for j in 0..n {
-                if jac[n * j..n * (j + 1)].iter().any(|v| *v != 0.0) {
+                if !self.known_zero[j] && jac[n * j..n * (j + 1)].iter().any(|v| *v != 0.0) {
                     self.active.push(j);
                 } else {
                     self.passive.push(j);
+                }
+            }
+            // Only the passive states whose rates depend on active ones need a row: a
+            // string's modal amplitudes out of contact have none, and then a solve costs
+            // no product. Which they are depends on `J` alone, not on `c`.
+            self.coupled.clear();
+            for &i in &self.passive {
+                if self.active.iter().any(|&j| jac[i + n * j] != 0.0) {
+                    self.coupled.push(i);
                 }
             }
             self.stale = false;
@@ -179,18 +200,25 @@ impl IterationMatrix {
                 self.block[rb + na * cb] = jac[i + n * j];
             }
         }
-        // Only the passive states whose rates depend on active ones need a row: a string's
-        // modal amplitudes out of contact have none, and then a solve costs no product.
         self.coupling.clear();
-        self.coupled.clear();
-        for &i in &self.passive {
-            if self.active.iter().any(|&j| jac[i + n * j] != 0.0) {
-                self.coupled.push(i);
-                self.coupling
-                    .extend(self.active.iter().map(|&j| c * jac[i + n * j]));
-            }
+        for &i in &self.coupled {
+            self.coupling
+                .extend(self.active.iter().map(|&j| c * jac[i + n * j]));
         }
         self.lu.factor_shifted(c, &self.block)
+    }
+
+    /// The states whose row and column of `W` are the identity's, ascending: outside the
+    /// Jacobian, and with a rate that does not depend on the states inside it. Solving
+    /// leaves their entries of the right-hand side as they are. Valid after
+    /// [`Self::factor_shifted`].
+    pub fn identity_rows(&self) -> impl Iterator<Item = usize> + '_ {
+        // Both lists ascend (built in index order): walk `coupled` along `passive`.
+        let mut coupled = self.coupled.iter().copied().peekable();
+        self.passive.iter().copied().filter(move |&i| {
+            while coupled.next_if(|&c| c < i).is_some() {}
+            coupled.next_if_eq(&i).is_none()
+        })
     }
 
     /// Solves `W x = b` in place.
@@ -271,7 +299,7 @@ mod tests {
         assert_eq!(w.coupled, vec![1, 3]);
         // State 3 made independent of the others: its row is dropped, its solution is b.
         set(&mut jac, 3, 2, 0.0);
-        w.jacobian_changed();
+        w.jacobian_changed(&[]);
         assert!(w.factor_shifted(c, &jac));
         assert_eq!(w.coupled, vec![1]);
         let mut b = [0.7, -1.1, 2.3, 0.4];
@@ -290,7 +318,7 @@ mod tests {
         }
         // A full Jacobian again: every state active.
         let full: Vec<f64> = (0..n * n).map(|k| 0.1 * (k as f64 + 1.0)).collect();
-        w.jacobian_changed();
+        w.jacobian_changed(&[]);
         assert!(w.factor_shifted(c, &full));
         assert_eq!(w.active.len(), n);
     }

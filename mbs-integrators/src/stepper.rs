@@ -108,6 +108,25 @@ impl Control {
         (s / n.max(1) as f64).sqrt()
     }
 
+    /// [`Control::step_error_norm`] over the components `live` alone (ascending), for
+    /// callers that know the others are frozen: with every other component's error zero
+    /// and its value unchanged, the same terms are added in the same order, so the norm
+    /// is the same to the bit.
+    pub fn step_error_norm_at(&self, live: &[usize], err: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        let mut n = 0usize;
+        let s: f64 = live
+            .iter()
+            .map(|&i| (err[i], (y0[i], y1[i])))
+            .filter(|(e, (a, b))| *e != 0.0 || a != b)
+            .map(|(e, (a, b))| {
+                n += 1;
+                let sc = self.atol + self.rtol * a.abs().max(b.abs());
+                (e / sc) * (e / sc)
+            })
+            .sum();
+        (s / n.max(1) as f64).sqrt()
+    }
+
     /// Hairer's automatic first step for a method of order `order`.
     pub fn initial_step(
         &self,
