@@ -6,6 +6,7 @@ use crate::error::{IntegratorError, Result};
 use crate::explicit::{Explicit, Scheme};
 use crate::ode::{Crossing, OdeSystem};
 use crate::options::{Method, Options};
+use crate::rosenbrock::Ros34Pw2;
 use crate::solution::{Event, EventAction, Solution, Stats, Termination};
 use crate::stepper::{Control, Stepper};
 use crate::trbdf2::TrBdf2;
@@ -97,6 +98,7 @@ pub fn solve_observed(
         Method::Rk4 => Box::new(Explicit::new(Scheme::Rk4, n, &ctl, None)?),
         Method::DormandPrince54 => Box::new(Dopri5::new(n, &ctl)),
         Method::TrBdf2 => Box::new(TrBdf2::new(n, &ctl)),
+        Method::Ros34Pw2 => Box::new(Ros34Pw2::new(n, &ctl)),
     };
     let mut run = Run::new(sys, opts, n, t0);
     stepper.start(run.sys, t0, y0, &mut run.stats)?;

@@ -22,6 +22,14 @@ pub enum Method {
     /// not damp errors the global error grows like `rtol^(2/3)`: ask for a tighter `rtol`
     /// than the accuracy wanted.
     TrBdf2,
+    /// ROS34PW2, the Rosenbrock–W method of Rang & Angermann (2005): four linear solves
+    /// with one matrix per step and no Newton iteration, third order with a second-order
+    /// error estimate, L-stable and stiffly accurate; the Jacobian is kept across steps (a
+    /// W-method keeps its order with any matrix) and taken again after a rejected step.
+    /// Four evaluations per step: with an exact Jacobian at hand (the system's own) it is
+    /// the cheapest method here for stiff contact; with finite differences TR-BDF2, which
+    /// needs fewer Jacobians, usually is. Fixed step if [`Options::fixed_step`] is set.
+    Ros34Pw2,
 }
 
 impl Method {
@@ -32,12 +40,16 @@ impl Method {
             Method::Rk4 => 4,
             Method::DormandPrince54 => 5,
             Method::TrBdf2 => 2,
+            Method::Ros34Pw2 => 3,
         }
     }
 
     /// Whether the method can control its step size.
     pub fn is_adaptive(self) -> bool {
-        matches!(self, Method::DormandPrince54 | Method::TrBdf2)
+        matches!(
+            self,
+            Method::DormandPrince54 | Method::TrBdf2 | Method::Ros34Pw2
+        )
     }
 }
 

@@ -17,6 +17,7 @@
 //! `W⁻¹` (Hosea & Shampine) so it does not overestimate on stiff components.
 
 use crate::error::{IntegratorError, Result};
+use crate::jacobian::Jacobian;
 use crate::linalg::IterationMatrix;
 use crate::ode::OdeSystem;
 use crate::solution::Stats;
@@ -72,20 +73,11 @@ pub(crate) struct TrBdf2 {
     f_fail: Vec<f64>,
     delta: Vec<f64>,
     est: Vec<f64>,
-    jac: nalgebra::DMatrix<f64>,
-    jac_tmp: Vec<f64>,
-    /// Columns of `jac` known to hold zeros (left out of the last Jacobians).
-    zero_columns: Vec<bool>,
-    /// Scratch of a Jacobian evaluation (no allocation per Jacobian): the state and rate it
-    /// is taken at, the perturbed state, which columns are needed, the internal states
-    /// probed together.
+    /// The Jacobian and its evaluation's scratch space.
+    jac: Jacobian,
+    /// A copy of the state and rate the Jacobian is taken at (the step's start).
     jac_y: Vec<f64>,
     jac_f: Vec<f64>,
-    jac_yp: Vec<f64>,
-    jac_needed: Vec<bool>,
-    jac_internal: Vec<usize>,
-    /// The system's states outside the Jacobian, asked once per solve.
-    outside: Option<Vec<std::ops::Range<usize>>>,
     jac_valid: bool,
     /// Whether `jac` was evaluated at the start of the current step.
     jac_fresh: bool,
@@ -132,15 +124,9 @@ impl TrBdf2 {
             f_fail: v(),
             delta: v(),
             est: v(),
-            jac: nalgebra::DMatrix::zeros(n, n),
-            jac_tmp: v(),
-            zero_columns: vec![false; n],
+            jac: Jacobian::new(n),
             jac_y: v(),
             jac_f: v(),
-            jac_yp: v(),
-            jac_needed: vec![true; n],
-            jac_internal: Vec::with_capacity(n),
-            outside: None,
             jac_valid: false,
             jac_fresh: false,
             lu: IterationMatrix::new(n),
@@ -232,89 +218,10 @@ impl TrBdf2 {
         f: &[f64],
         st: &mut Stats,
     ) -> Result<()> {
-        st.jacobian_evals += 1;
-        if sys.has_jacobian() {
-            sys.jacobian(t, y, &mut self.jac)
-                .map_err(|source| IntegratorError::System { t, source })?;
-            self.zero_columns.fill(false);
-            if self.jac.as_slice().iter().any(|v| !v.is_finite()) {
-                return Err(IntegratorError::System {
-                    t,
-                    source: crate::SystemError::new("the Jacobian has non-finite entries"),
-                });
-            }
-        } else {
-            let n = self.n;
-            let mut yp = std::mem::take(&mut self.jac_yp);
-            yp.clear();
-            yp.extend_from_slice(y);
-            // States the system marks as outside the Jacobian keep zero columns and cost
-            // no evaluation (a string's modal amplitudes, see
-            // `OdeSystem::states_outside_jacobian`).
-            let mut needed = std::mem::take(&mut self.jac_needed);
-            needed.clear();
-            needed.resize(n, true);
-            let outside = self
-                .outside
-                .get_or_insert_with(|| sys.states_outside_jacobian());
-            for r in outside.iter() {
-                for j in r.start.min(n)..r.end.min(n) {
-                    needed[j] = false;
-                }
-            }
-            // The other internal states beyond a mechanical [q, v] (force elements'
-            // memories) are probed together first: when moving them all at once changes no
-            // derivative at all, their columns are zero and their evaluations are saved.
-            let grouped = sys.second_order_split().map_or(n, |nv| (2 * nv).min(n));
-            let mut internal = std::mem::take(&mut self.jac_internal);
-            internal.clear();
-            internal.extend((grouped..n).filter(|&j| needed[j]));
-            if internal.len() > 1 {
-                for &j in &internal {
-                    yp[j] = y[j] + f64::EPSILON.sqrt() * y[j].abs().max(1e-5);
-                }
-                if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
-                    return Err(non_finite(t, &self.jac_tmp));
-                }
-                yp[grouped..].copy_from_slice(&y[grouped..]);
-                if self.jac_tmp == f {
-                    for &j in &internal {
-                        needed[j] = false;
-                    }
-                }
-            }
-            for j in 0..n {
-                if !needed[j] {
-                    // Zeroed once, kept zero while the column stays out.
-                    if !self.zero_columns[j] {
-                        self.jac.column_mut(j).fill(0.0);
-                        self.zero_columns[j] = true;
-                    }
-                    continue;
-                }
-                let yj = y[j];
-                let dj = f64::EPSILON.sqrt() * yj.abs().max(1e-5);
-                yp[j] = yj + dj;
-                let dj = yp[j] - yj;
-                // `eval` refuses non-finite rates, so every column is finite (barring an
-                // overflow of the quotient).
-                if !eval(sys, t, &yp, &mut self.jac_tmp, st)? {
-                    return Err(non_finite(t, &self.jac_tmp));
-                }
-                let column = self.jac.column_mut(j);
-                for ((out, a), b) in column.into_iter().zip(&self.jac_tmp).zip(f) {
-                    *out = (a - b) / dj;
-                }
-                self.zero_columns[j] = false;
-                yp[j] = yj;
-            }
-            self.jac_yp = yp;
-            self.jac_needed = needed;
-            self.jac_internal = internal;
-        }
+        self.jac.evaluate(sys, t, y, f, st)?;
         self.jac_valid = true;
         self.jac_fresh = true;
-        self.lu.jacobian_changed(&self.zero_columns);
+        self.lu.jacobian_changed(&self.jac.zero_columns);
         self.lu_c = f64::NAN;
         Ok(())
     }
@@ -325,7 +232,7 @@ impl TrBdf2 {
             return Ok(());
         }
         st.lu_decompositions += 1;
-        if !self.lu.factor_shifted(c, self.jac.as_slice()) {
+        if !self.lu.factor_shifted(c, self.jac.m.as_slice()) {
             self.lu_c = f64::NAN;
             return Err(IntegratorError::SingularMatrix {
                 t: self.t,

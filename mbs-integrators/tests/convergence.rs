@@ -270,6 +270,16 @@ fn tr_bdf2_with_a_fixed_step_is_second_order() {
     assert_order(&logistic(m, 20), 2.0, 0.1, 0.1);
 }
 
+#[test]
+fn ros34pw2_with_a_fixed_step_is_third_order() {
+    // The Riccati problem depends on time and the method leaves out ∂f/∂t; from its
+    // coarsest steps the order comes up to 3 (halvings 2.84, 2.93, 2.97, 2.98).
+    let m = Method::Ros34Pw2;
+    assert_order(&oscillator(m, 40), 3.0, 0.1, 0.15);
+    assert_order(&riccati(m, 160), 3.0, 0.1, 0.2);
+    assert_order(&logistic(m, 80), 3.0, 0.1, 0.15);
+}
+
 /// Runs `method` adaptively at each tolerance (atol = rtol / 100), returning
 /// (rtol, global error, solution).
 fn adaptive(
@@ -376,6 +386,31 @@ fn adaptive_tr_bdf2_meets_its_tolerance() {
         assert!(
             *err <= 100.0 * rtol,
             "TR-BDF2 logistic: global error {err:.3e} at rtol {rtol:.0e}"
+        );
+    }
+    assert_tightening("logistic", &runs, 2.0, 10.0);
+}
+
+#[test]
+fn adaptive_ros34pw2_meets_its_tolerance() {
+    // Error-per-step control of a third-order method with a second-order estimate: about
+    // tol^(−1/3) steps; on the oscillator the global error is at most steps × tol.
+    let m = Method::Ros34Pw2;
+    let runs = oscillator_runs(m);
+    for (rtol, err, sol) in &runs {
+        let bound = sol.stats.steps as f64 * rtol * OSC_AMPLITUDE;
+        assert!(
+            *err <= bound,
+            "ROS34PW2 oscillator: global error {err:.3e} at rtol {rtol:.0e} above \
+             steps × rtol × amplitude = {bound:.3e}"
+        );
+    }
+    assert_tightening("oscillator", &runs, 2.0, 10.0);
+    let runs = logistic_runs(m, 10.0);
+    for (rtol, err, _) in &runs {
+        assert!(
+            *err <= 100.0 * rtol,
+            "ROS34PW2 logistic: global error {err:.3e} at rtol {rtol:.0e}"
         );
     }
     assert_tightening("logistic", &runs, 2.0, 10.0);

@@ -71,6 +71,7 @@ fn bouncing_ball_impacts_are_located_to_1e9_s() {
             Options::with_tolerances(1e-10, 1e-12),
         ),
         (Method::TrBdf2, Options::with_tolerances(1e-8, 1e-10)),
+        (Method::Ros34Pw2, Options::with_tolerances(1e-8, 1e-10)),
         (Method::Rk4, Options::default().fixed(1e-2)),
     ] {
         let sol = solve_with_events(

@@ -94,6 +94,69 @@ fn tr_bdf2_robertson_at_t_40_matches_hairer_wanner() {
 }
 
 #[test]
+fn ros34pw2_robertson_at_t_40_matches_hairer_wanner() {
+    for analytic in [false, true] {
+        let sol = rober(Method::Ros34Pw2, analytic, 40.0, &robertson_opts());
+        let y = &sol.y_final;
+        let errs: Vec<f64> = (0..3).map(|i| rel(y[i], ROBER_40[i])).collect();
+        print_stats(
+            &format!("ROS34PW2 Robertson to t = 40, analytic Jacobian {analytic}"),
+            &sol.stats,
+        );
+        println!("  y = {}, relative errors {}", sci(y, 10), sci(&errs, 2));
+        for i in 0..3 {
+            assert!(
+                errs[i] < 1e-4,
+                "y{} = {:e}, relative error {:e}",
+                i + 1,
+                y[i],
+                errs[i]
+            );
+        }
+        // Linearly implicit: no Newton iteration, at most four evaluations a step (three
+        // for a rejected one) besides the Jacobians'.
+        assert_eq!(sol.stats.newton_iterations, 0);
+        let jacobian_evals = if analytic {
+            0
+        } else {
+            3 * sol.stats.jacobian_evals
+        };
+        assert!(
+            sol.stats.derivative_evals
+                <= 4 * sol.stats.steps + 3 * sol.stats.rejected + jacobian_evals + 3,
+            "{:?}",
+            sol.stats
+        );
+        if analytic {
+            // The system's own Jacobian is taken at every step.
+            assert_eq!(sol.stats.jacobian_evals, sol.stats.steps, "{:?}", sol.stats);
+        } else {
+            // A W-method keeps its finite-difference Jacobian across steps.
+            assert!(
+                5 * sol.stats.jacobian_evals < sol.stats.steps,
+                "{:?}",
+                sol.stats
+            );
+        }
+    }
+}
+
+#[test]
+fn ros34pw2_van_der_pol_matches_the_test_set() {
+    for analytic in [false, true] {
+        let sol = vdp(Method::Ros34Pw2, 1e-6, analytic, &vdp_opts(50_000)).unwrap();
+        let y = &sol.y_final;
+        let errs: Vec<f64> = (0..2).map(|i| rel(y[i], VDP_2[i])).collect();
+        print_stats(
+            &format!("ROS34PW2 Van der Pol eps = 1e-6, analytic Jacobian {analytic}"),
+            &sol.stats,
+        );
+        println!("  y = {}, relative errors {}", sci(y, 10), sci(&errs, 2));
+        assert!(errs[0] < 1e-3 && errs[1] < 1e-3, "relative errors {errs:?}");
+    }
+}
+
+#[test]
 fn tr_bdf2_robertson_at_t_1e11_matches_the_test_set() {
     // On the long run y1 (~2e-8) and y2 (~8e-14) sit below or near atol = 1e-10, so their
     // relative accuracy is set by atol / y1 ≈ 5e-3, not by rtol: ask for 2e-2. y2 is in
