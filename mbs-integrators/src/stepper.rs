@@ -94,18 +94,7 @@ impl Control {
     /// components that moved or carry an error: states frozen through the step (a
     /// string's modal amplitudes between strikes) do not dilute the others' error.
     pub fn step_error_norm(&self, err: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
-        let mut n = 0usize;
-        let s: f64 = err
-            .iter()
-            .zip(y0.iter().zip(y1))
-            .filter(|(e, (a, b))| **e != 0.0 || a != b)
-            .map(|(e, (a, b))| {
-                n += 1;
-                let sc = self.atol + self.rtol * a.abs().max(b.abs());
-                (e / sc) * (e / sc)
-            })
-            .sum();
-        (s / n.max(1) as f64).sqrt()
+        self.step_error_norm_over(0..err.len(), err, y0, y1)
     }
 
     /// [`Control::step_error_norm`] over the components `live` alone (ascending), for
@@ -113,10 +102,19 @@ impl Control {
     /// and its value unchanged, the same terms are added in the same order, so the norm
     /// is the same to the bit.
     pub fn step_error_norm_at(&self, live: &[usize], err: &[f64], y0: &[f64], y1: &[f64]) -> f64 {
+        self.step_error_norm_over(live.iter().copied(), err, y0, y1)
+    }
+
+    fn step_error_norm_over(
+        &self,
+        indices: impl Iterator<Item = usize>,
+        err: &[f64],
+        y0: &[f64],
+        y1: &[f64],
+    ) -> f64 {
         let mut n = 0usize;
-        let s: f64 = live
-            .iter()
-            .map(|&i| (err[i], (y0[i], y1[i])))
+        let s: f64 = indices
+            .map(|i| (err[i], (y0[i], y1[i])))
             .filter(|(e, (a, b))| *e != 0.0 || a != b)
             .map(|(e, (a, b))| {
                 n += 1;

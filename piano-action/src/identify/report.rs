@@ -435,19 +435,22 @@ pub(super) fn throughput_markdown(stages: &[StageWork]) -> String {
          |---|---:|---:|---:|---:|---:|---:|\n",
     );
     for w in stages {
-        let _ = writeln!(
-            s,
-            "| {} | {:.1} | {} | {} | {} | {:.2} | {:.1} |",
-            w.stage,
-            w.wall_s,
-            w.fits,
-            w.evaluations,
-            w.simulations,
-            w.fits_per_s,
-            w.simulations_per_s
-        );
+        let _ = writeln!(s, "| {} |", throughput_cells(w, &w.stage).join(" | "));
     }
     s
+}
+
+/// A stage's row: its name as given, wall time, fits, evaluations, simulations and rates.
+fn throughput_cells(w: &StageWork, stage: &str) -> [String; 7] {
+    [
+        stage.to_string(),
+        format!("{:.1}", w.wall_s),
+        w.fits.to_string(),
+        w.evaluations.to_string(),
+        w.simulations.to_string(),
+        format!("{:.2}", w.fits_per_s),
+        format!("{:.1}", w.simulations_per_s),
+    ]
 }
 
 /// The work of each stage and its rates as an HTML table.
@@ -457,19 +460,12 @@ pub(super) fn throughput_html(stages: &[StageWork]) -> String {
          <th>simulations</th><th>fits/s</th><th>simulations/s</th></tr></thead><tbody>\n",
     );
     for w in stages {
-        let _ = writeln!(
-            s,
-            "<tr><td>{}</td><td class=\"num\">{:.1}</td><td class=\"num\">{}</td>\
-             <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{:.2}</td>\
-             <td class=\"num\">{:.1}</td></tr>",
-            escape(&w.stage),
-            w.wall_s,
-            w.fits,
-            w.evaluations,
-            w.simulations,
-            w.fits_per_s,
-            w.simulations_per_s
-        );
+        let [stage, numbers @ ..] = throughput_cells(w, &escape(&w.stage));
+        let _ = write!(s, "<tr><td>{stage}</td>");
+        for n in numbers {
+            let _ = write!(s, "<td class=\"num\">{n}</td>");
+        }
+        s.push_str("</tr>\n");
     }
     s.push_str("</tbody></table>\n");
     s
