@@ -3,7 +3,9 @@
 
 use std::sync::Arc;
 
-use mbs_core::{BodyId, Crossing, ForceContext, ForceElement, Loads, Model};
+use mbs_core::{
+    BodyId, Crossing, ForceContext, ForceElement, LoadJacobian, Loads, Model, central_difference,
+};
 
 use crate::error::{ContactError, Result};
 use crate::geometry::{Proximity, Shape, proximity};
@@ -355,6 +357,56 @@ impl ForceElement for Contact {
         ];
         loads.add_force_at_point(self.sides[1].body, out.point, f);
         loads.add_force_at_point(self.sides[0].body, out.point, [-f[0], -f[1]]);
+    }
+
+    /// Laws without memory only (a law's internal states would need their own rows).
+    fn has_load_derivatives(&self) -> bool {
+        self.normal.state_count() == 0
+    }
+
+    /// The normal law's `∂F_n/∂δ`, `∂F_n/∂δ̇` (closed form where the law has one, else
+    /// central differences) and the friction law's `∂F_t/∂F_n`, `∂F_t/∂slip` (central
+    /// differences), through the gap `δ = −n·Δ` and the slip `t·Δ̇` at the contact point.
+    fn load_derivatives(&self, ctx: &ForceContext<'_>, jac: &mut LoadJacobian<'_>) {
+        let p = self.proximity(ctx);
+        if p.gap.is_nan() || p.gap >= 0.0 {
+            return;
+        }
+        let out = self.compute_at(p, ctx, &mut []);
+        if !out.active {
+            return;
+        }
+        let (delta, delta_dot) = (-out.gap, -out.gap_rate);
+        let law = |d: f64, dd: f64| self.normal.force(d, dd, &[], &mut []).max(0.0);
+        let kn = match self.normal.tangent_stiffness(delta, delta_dot, &[]) {
+            Some(k) => k,
+            None => central_difference(|d| law(d, delta_dot), delta, delta),
+        };
+        let cn = match self.normal.rate_derivative(delta, delta_dot, &[]) {
+            Some(c) => c,
+            None => central_difference(|dd| law(delta, dd), delta_dot, 1e-4),
+        };
+        let (mu, st) = match &self.friction {
+            Some(f) => (
+                central_difference(|fnn| f.force(fnn, out.slip), out.normal_force, 1.0),
+                central_difference(|s| f.force(out.normal_force, s), out.slip, 1e-4),
+            ),
+            None => (0.0, 0.0),
+        };
+        let n = out.normal;
+        let t = [-n[1], n[0]];
+        // F = F_n n + F_t t with δ = −n·Δ, δ̇ = −n·Δ̇, slip = t·Δ̇ and F_t = F_t(F_n, slip).
+        let dir = [n[0] + mu * t[0], n[1] + mu * t[1]];
+        let mut dq = [[0.0; 2]; 2];
+        let mut dv = [[0.0; 2]; 2];
+        for i in 0..2 {
+            for j in 0..2 {
+                dq[i][j] = -kn * dir[i] * n[j];
+                dv[i][j] = -cn * dir[i] * n[j] + st * t[i] * t[j];
+            }
+        }
+        jac.set_point(self.sides[0].body, self.sides[1].body, out.point);
+        jac.add_point_force(dq, dv);
     }
 
     fn position_len(&self) -> usize {

@@ -26,6 +26,13 @@ pub trait NormalLaw: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The rate derivative `∂F/∂δ̇` (N·s/m) at fixed `delta` and states, when the law knows
+    /// it in closed form; `None` (the default) when it does not, and callers that need it
+    /// (a contact's Jacobian, [`crate::Contact`]) then take a central difference.
+    fn rate_derivative(&self, _delta: f64, _delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        None
+    }
+
     /// Whether the law ignores `delta_dot` altogether: neither the force nor the rates of
     /// its internal states depend on it (a purely elastic law such as [`Hertz`]). `false`
     /// by default: the law may depend on the rate. [`crate::StringContact`] relies on it to
@@ -100,6 +107,10 @@ impl<L: NormalLaw + ?Sized> NormalLaw for Box<L> {
         (**self).tangent_stiffness(delta, delta_dot, states)
     }
 
+    fn rate_derivative(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        (**self).rate_derivative(delta, delta_dot, states)
+    }
+
     fn rate_independent(&self) -> bool {
         (**self).rate_independent()
     }
@@ -116,6 +127,10 @@ impl<L: NormalLaw + ?Sized> NormalLaw for std::sync::Arc<L> {
 
     fn tangent_stiffness(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
         (**self).tangent_stiffness(delta, delta_dot, states)
+    }
+
+    fn rate_derivative(&self, delta: f64, delta_dot: f64, states: &[f64]) -> Option<f64> {
+        (**self).rate_derivative(delta, delta_dot, states)
     }
 
     fn rate_independent(&self) -> bool {
@@ -186,6 +201,12 @@ impl NormalLaw for KelvinVoigt {
         // ∂F/∂δ = k where the force is positive.
         let active = delta > 0.0 && self.stiffness * delta + self.damping * delta_dot > 0.0;
         Some(if active { self.stiffness } else { 0.0 })
+    }
+
+    fn rate_derivative(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ̇ = c where the force is positive.
+        let active = delta > 0.0 && self.stiffness * delta + self.damping * delta_dot > 0.0;
+        Some(if active { self.damping } else { 0.0 })
     }
 }
 
@@ -271,6 +292,10 @@ impl NormalLaw for Hertz {
             return Some(0.0);
         }
         Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta)
+    }
+
+    fn rate_derivative(&self, _delta: f64, _delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        Some(0.0)
     }
 
     fn rate_independent(&self) -> bool {
@@ -428,6 +453,15 @@ impl NormalLaw for HuntCrossley {
             return Some(0.0);
         }
         Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta * damping)
+    }
+
+    fn rate_derivative(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ̇ = (3/2) α k δⁿ where the force is positive.
+        let damping = 1.0 + 1.5 * self.alpha * delta_dot;
+        if delta <= 0.0 || damping <= 0.0 {
+            return Some(0.0);
+        }
+        Some(1.5 * self.alpha * self.stiffness * power(delta, self.exponent))
     }
 }
 
@@ -595,6 +629,27 @@ impl NormalLaw for HystereticFelt {
         self.stiffness
             * power(delta, self.exponent)
             * (1.0 + self.hysteresis * (delta_dot / self.v_eps).tanh())
+    }
+
+    fn tangent_stiffness(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ = p K δᵖ⁻¹ (1 + a tanh(δ̇/v_ε))
+        if delta <= 0.0 {
+            return Some(0.0);
+        }
+        let switch = 1.0 + self.hysteresis * (delta_dot / self.v_eps).tanh();
+        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta * switch)
+    }
+
+    fn rate_derivative(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
+        // ∂F/∂δ̇ = K δᵖ a (1 − tanh²(δ̇/v_ε)) / v_ε
+        if delta <= 0.0 {
+            return Some(0.0);
+        }
+        let th = (delta_dot / self.v_eps).tanh();
+        Some(
+            self.stiffness * power(delta, self.exponent) * self.hysteresis * (1.0 - th * th)
+                / self.v_eps,
+        )
     }
 }
 

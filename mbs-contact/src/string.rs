@@ -35,7 +35,7 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use mbs_core::{BodyId, Crossing, ForceContext, ForceElement, Loads, Model};
+use mbs_core::{BodyId, Crossing, ForceContext, ForceElement, LoadJacobian, Loads, Model};
 
 use crate::element::{ContactOutput, ContactSide, ResolvedSide, resolve, velocity_at};
 use crate::error::{ContactError, Result};
@@ -926,6 +926,52 @@ impl ForceElement for StringContact {
                 da[k] = -g * sin;
                 db[k] = g * cos;
             }
+        });
+    }
+
+    /// With a memoryless, rate-independent felt (the string's modes then stay out of the
+    /// Jacobian, see [`ForceElement::states_outside_jacobian`]).
+    fn has_load_derivatives(&self) -> bool {
+        self.felt.state_count() == 0 && self.felt.rate_independent()
+    }
+
+    /// `∂F/∂d_m` of the felt in series with the residual spring (a central difference of
+    /// the series solution), through the penetration `d_m = −(n·Δ + u)` at the contact
+    /// point: the force on the striker, and the modal rates `∝ F`.
+    fn load_derivatives(&self, ctx: &ForceContext<'_>, jac: &mut LoadJacobian<'_>) {
+        let ns = self.string.state_count();
+        let p = self.rigid_proximity(ctx);
+        if !p.gap.is_finite() || p.gap - self.string.displacement_bound(&ctx.states[..ns]) > 0.0 {
+            return;
+        }
+        let (_, _, _, inter) = self.evaluate(ctx, p, &mut []);
+        if inter.force <= 0.0 {
+            return;
+        }
+        // In series with the residual spring (F = u_r / c_r at the felt's compression
+        // d_m − u_r): ∂F/∂d_m = k_f / (1 + c_r k_f), k_f the felt's tangent stiffness.
+        let kf = self.felt_stiffness(inter.felt, inter.felt_rate, &[], &mut []);
+        let kd = kf / (1.0 + self.string.residual.max(0.0) * kf);
+        let n = p.normal;
+        let dq = [
+            [-kd * n[0] * n[0], -kd * n[0] * n[1]],
+            [-kd * n[1] * n[0], -kd * n[1] * n[1]],
+        ];
+        let point = [
+            0.5 * (p.point_a[0] + p.point_b[0]),
+            0.5 * (p.point_a[1] + p.point_b[1]),
+        ];
+        jac.set_point(BodyId::GROUND, self.striker.body, point);
+        jac.add_point_force(dq, [[0.0; 2]; 2]);
+        // dA_k/dt = −g_k F sin(ω_k t), dB_k/dt = g_k F cos(ω_k t), with ∂F/∂Δ = −k_d n.
+        let s = &self.string;
+        let modes = s.modes();
+        let dir = [kd * n[0], kd * n[1]];
+        self.trig.with(s, ctx.t, |trig| {
+            jac.add_rates_at_point(0..modes, dir, [0.0; 2], |k| s.gain[k] * trig[k].0);
+            jac.add_rates_at_point(modes..2 * modes, dir, [0.0; 2], |k| {
+                -s.gain[k - modes] * trig[k - modes].1
+            });
         });
     }
 

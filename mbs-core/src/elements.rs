@@ -6,6 +6,7 @@ use std::sync::Arc;
 use crate::error::{CoreError, Result};
 use crate::force::{Crossing, ForceContext, ForceElement, Loads, check_coordinate, check_frame};
 use crate::kinematics::frame_point;
+use crate::load_jacobian::{LoadJacobian, Wrt, central_difference};
 use crate::model::{BodyId, Model};
 use crate::time_function::TimeFunction;
 
@@ -121,6 +122,16 @@ impl ForceElement for JointSpringDamper {
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
         let k = self.coordinate;
         loads.add_generalized(k, self.force(ctx.q[k], ctx.v[k]));
+    }
+
+    fn has_load_derivatives(&self) -> bool {
+        true
+    }
+
+    fn load_derivatives(&self, _ctx: &ForceContext<'_>, jac: &mut LoadJacobian<'_>) {
+        let k = self.coordinate;
+        jac.add_generalized(k, Wrt::Q(k), -self.law.stiffness);
+        jac.add_generalized(k, Wrt::V(k), -self.law.damping);
     }
 
     fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
@@ -583,6 +594,17 @@ impl ForceElement for PivotFriction {
         loads.add_generalized(k, self.torque(ctx.v[k]));
     }
 
+    fn has_load_derivatives(&self) -> bool {
+        true
+    }
+
+    /// `∂τ/∂v` by a central difference on the scale of the regularization velocity.
+    fn load_derivatives(&self, ctx: &ForceContext<'_>, jac: &mut LoadJacobian<'_>) {
+        let k = self.coordinate;
+        let d = central_difference(|v| self.torque(v), ctx.v[k], self.law.regularization);
+        jac.add_generalized(k, Wrt::V(k), d);
+    }
+
     fn switch_count(&self) -> usize {
         usize::from(self.reversal_events)
     }
@@ -667,6 +689,20 @@ impl ForceElement for JointLimit {
     fn apply(&self, ctx: &ForceContext<'_>, loads: &mut Loads<'_>, _rates: &mut [f64]) {
         let k = self.coordinate;
         loads.add_generalized(k, self.torque(ctx.q[k], ctx.v[k]));
+    }
+
+    fn has_load_derivatives(&self) -> bool {
+        true
+    }
+
+    /// `−k` and `−c` where the stop pushes (zero where the clamp that keeps the damping
+    /// from pulling holds the torque at zero).
+    fn load_derivatives(&self, ctx: &ForceContext<'_>, jac: &mut LoadJacobian<'_>) {
+        let k = self.coordinate;
+        if self.torque(ctx.q[k], ctx.v[k]) != 0.0 {
+            jac.add_generalized(k, Wrt::Q(k), -self.stiffness);
+            jac.add_generalized(k, Wrt::V(k), -self.damping);
+        }
     }
 
     fn potential_energy(&self, ctx: &ForceContext<'_>) -> f64 {
@@ -844,4 +880,12 @@ impl ForceElement for AppliedLoad {
             }
         }
     }
+
+    fn has_load_derivatives(&self) -> bool {
+        true
+    }
+
+    /// None: a load given as a function of time changes with the state only through its
+    /// lever arm, a geometric term [`System::jacobian`](crate::System::jacobian) leaves out.
+    fn load_derivatives(&self, _ctx: &ForceContext<'_>, _jac: &mut LoadJacobian<'_>) {}
 }

@@ -229,6 +229,20 @@ pub trait ForceElement: Send + Sync {
         0..0
     }
 
+    /// Whether [`ForceElement::load_derivatives`] gives this element's derivatives, so that
+    /// a [`crate::System`] made only of such elements has a Jacobian
+    /// ([`crate::System::jacobian`]). `false` by default.
+    fn has_load_derivatives(&self) -> bool {
+        false
+    }
+
+    /// Writes the derivatives of this element's loads and internal-state rates at the state
+    /// in `ctx` into `jac` (see [`crate::LoadJacobian`] for what is kept and what is left
+    /// out). Called only when [`ForceElement::has_load_derivatives`] is `true`; must not
+    /// allocate. Columns of [`ForceElement::states_outside_jacobian`] are taken as zero
+    /// whatever is written there.
+    fn load_derivatives(&self, _ctx: &ForceContext<'_>, _jac: &mut crate::LoadJacobian<'_>) {}
+
     /// How many numbers this element keeps from the **position stage**: results that depend
     /// on the poses alone (time and coordinates, not velocities nor internal states), such
     /// as a contact's nearest points. The system computes them once per time and

@@ -63,7 +63,7 @@ fn fill(
 
 /// Angular and linear (at world point `p`) velocity per unit rate of body `j`'s joint.
 #[inline]
-fn column(model: &Model, data: &Data, j: BodyId, p: [f64; 2]) -> (f64, [f64; 2]) {
+pub(crate) fn column(model: &Model, data: &Data, j: BodyId, p: [f64; 2]) -> (f64, [f64; 2]) {
     let x = &data.x_world[j.0];
     match model.bodies[j.0].joint {
         // ω = 1 about the joint origin o: ṗ = ẑ × (p − o)

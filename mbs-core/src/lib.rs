@@ -66,6 +66,7 @@ pub mod inspect;
 mod jacobian;
 mod kinematics;
 mod layout;
+mod load_jacobian;
 mod model;
 mod rnea;
 pub mod spatial;
@@ -88,6 +89,7 @@ pub use kinematics::{
     angular_velocity, forward_kinematics, forward_kinematics_acc, frame_point, frame_pose,
     point_acceleration, point_position, point_velocity, update_poses,
 };
+pub use load_jacobian::{LoadJacobian, Wrt, central_difference};
 pub use model::{BodyId, Frame, FrameId, JointType, Model};
 pub use rnea::{gravity_torque, nonlinear_effects, rnea, rnea_with_forces};
 pub use spatial::{Force, Inertia, Motion, Transform};

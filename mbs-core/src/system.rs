@@ -4,14 +4,19 @@
 use std::ops::Range;
 use std::sync::Arc;
 
+use nalgebra::DMatrix;
+
 use crate::aba::{Prescribed, articulated_pass};
+use crate::crba::crba_pass;
 use crate::data::Data;
 use crate::energy::{kinetic_energy_from_kinematics, potential_energy_from_poses};
 use crate::error::{CoreError, Result};
 use crate::force::{Crossing, ForceContext, ForceElement, Loads};
 use crate::kinematics::kinematics_pass;
+use crate::load_jacobian::LoadJacobian;
 use crate::model::Model;
 use crate::rnea::body_forces_to_generalized;
+use crate::rnea::{Output, rnea_pass};
 use crate::spatial::Force;
 use crate::time_function::{Drive, DriveState};
 
@@ -92,6 +97,30 @@ pub struct Workspace {
     /// (`None`: not computed).
     position_key: Option<(u64, f64)>,
     position_q: Vec<f64>,
+    /// Scratch of [`System::jacobian`] (sized at its first call).
+    jacobian: JacobianScratch,
+}
+
+/// What [`System::jacobian`] works in.
+#[derive(Clone, Debug, Default)]
+struct JacobianScratch {
+    /// `∂τ/∂x`, nv × len(x).
+    dtau: DMatrix<f64>,
+    /// Which columns of `x` are outside the Jacobian.
+    outside: Vec<bool>,
+    /// The relative point Jacobian of [`LoadJacobian::set_point`].
+    g: Vec<[f64; 2]>,
+    /// The free coordinates, and the Cholesky factor of their mass matrix (row-major).
+    free: Vec<usize>,
+    chol: Vec<f64>,
+    rhs: Vec<f64>,
+    /// The derivative at the Jacobian's state (for its accelerations), perturbed
+    /// coordinates and velocities, the inverse dynamics there, and the data they are computed in.
+    xdot: Vec<f64>,
+    qp: Vec<f64>,
+    vp: Vec<f64>,
+    tau0: Vec<f64>,
+    data: Option<Data>,
 }
 
 impl Workspace {
@@ -231,15 +260,7 @@ impl System {
     /// The ranges of internal states an implicit integrator may leave out of its Jacobian
     /// ([`ForceElement::states_outside_jacobian`]).
     pub fn states_outside_jacobian(&self) -> Vec<Range<usize>> {
-        self.entries
-            .iter()
-            .filter_map(|en| {
-                let local = en.element.states_outside_jacobian();
-                let len = en.states.len();
-                let (a, b) = (local.start.min(len), local.end.min(len));
-                (a < b).then(|| en.states.start + a..en.states.start + b)
-            })
-            .collect()
+        self.states_outside_ranges().collect()
     }
 
     /// The element and local index of switching function `k`, and its crossing direction.
@@ -271,6 +292,7 @@ impl System {
             positions: vec![0.0; self.position_len],
             position_key: None,
             position_q: vec![0.0; nv],
+            jacobian: JacobianScratch::default(),
         }
     }
 
@@ -534,6 +556,270 @@ impl System {
         Ok(())
     }
 
+    /// Whether every force element gives its load derivatives
+    /// ([`ForceElement::has_load_derivatives`]), so that [`System::jacobian`] applies.
+    pub fn has_jacobian(&self) -> bool {
+        self.entries
+            .iter()
+            .all(|en| en.element.has_load_derivatives())
+    }
+
+    /// The Jacobian `∂ẋ/∂x` of [`System::derivative`] at `(t, x)`, written into `jac`
+    /// (len(x) × len(x)), from the force elements' load derivatives
+    /// ([`ForceElement::load_derivatives`]):
+    ///
+    /// - `∂q̇/∂v = I` for the free coordinates;
+    /// - `∂q̈_f/∂x = M_ff⁻¹ ∂τ_f/∂x` for the free ones `f` (`M_ff` their block of the mass
+    ///   matrix, prescribed accelerations held), zero for prescribed ones;
+    /// - the internal states' rows as their elements give them;
+    /// - the columns of prescribed coordinates zero (their states are not read).
+    ///
+    /// with the inertial part `−∂(M q̈ + C + g)/∂q` and `−∂C/∂v` at this state's
+    /// accelerations taken by forward differences of inverse dynamics (a stiff contact makes
+    /// `q̈` large, and with it the change of `M q̈` with the pose).
+    ///
+    /// It is not the exact derivative. Left out are the geometric terms listed on
+    /// [`LoadJacobian`]
+    /// (lever arms and normals turning with the pose, the convective part of a contact's
+    /// gap rate), which touch the coordinate columns only. On the piano action's loud
+    /// keystroke the velocity columns agree with central differences to 1e-3
+    /// (`piano-action/tests/jacobian.rs`); the coordinate columns can be off by much more
+    /// where a contact's rate-dependent law is steep, through the convective term. A Newton
+    /// iteration or a Rosenbrock–W method keeps its order with such a matrix; how many
+    /// steps it costs depends on what is missing.
+    ///
+    /// The columns of [`System::states_outside_jacobian`] are not written: the caller keeps
+    /// them zero (they are zero in this Jacobian). Errors: wrong shape, a bad state, an
+    /// element without load derivatives (named), a mass matrix that is not positive
+    /// definite, a non-finite entry.
+    pub fn jacobian(
+        &self,
+        ws: &mut Workspace,
+        t: f64,
+        x: &[f64],
+        jac: &mut DMatrix<f64>,
+    ) -> Result<()> {
+        self.jacobian_with_rate(ws, t, x, None, jac)
+    }
+
+    /// [`System::jacobian`] given the derivative `xdot` at `(t, x)` when the caller has it
+    /// (an integrator always does), which saves evaluating it again for the accelerations.
+    pub fn jacobian_with_rate(
+        &self,
+        ws: &mut Workspace,
+        t: f64,
+        x: &[f64],
+        xdot: Option<&[f64]>,
+        jac: &mut DMatrix<f64>,
+    ) -> Result<()> {
+        let n = self.state_len;
+        if let Some(f) = xdot
+            && f.len() != n
+        {
+            return Err(CoreError::DimensionMismatch {
+                what: "xdot",
+                expected: n,
+                got: f.len(),
+            });
+        }
+        if jac.nrows() != n || jac.ncols() != n {
+            return Err(CoreError::ShapeMismatch {
+                what: "system jacobian",
+                expected: (n, n),
+                got: (jac.nrows(), jac.ncols()),
+            });
+        }
+        if let Some(en) = self
+            .entries
+            .iter()
+            .find(|en| !en.element.has_load_derivatives())
+        {
+            return Err(CoreError::InvalidParameter {
+                item: en.element.name().to_string(),
+                message: "gives no load derivatives, so the system has no Jacobian".into(),
+            });
+        }
+        self.prepare(ws, t, x)?;
+        let nv = self.model.nv();
+        let mut sc = std::mem::take(&mut ws.jacobian);
+        if sc.dtau.shape() != (nv, n) {
+            sc.dtau = DMatrix::zeros(nv, n);
+            sc.g = vec![[0.0; 2]; nv];
+            sc.rhs = vec![0.0; nv];
+            sc.chol = vec![0.0; nv * nv];
+            sc.free = Vec::with_capacity(nv);
+        }
+        sc.outside.clear();
+        sc.outside.resize(n, false);
+        for r in self.states_outside_ranges() {
+            sc.outside[r].fill(true);
+        }
+        sc.dtau.as_mut_slice().fill(0.0);
+        for c in 0..n {
+            if !sc.outside[c] {
+                jac.as_mut_slice()[c * n..(c + 1) * n].fill(0.0);
+            }
+        }
+        for en in &self.entries {
+            let ctx = self.context(
+                &ws.data,
+                &ws.q,
+                &ws.v,
+                t,
+                &x[en.states.clone()],
+                &ws.positions[en.positions.clone()],
+            );
+            let mut lj = LoadJacobian {
+                model: &self.model,
+                data: &ws.data,
+                dtau: &mut sc.dtau,
+                jac,
+                states: en.states.clone(),
+                outside: &sc.outside,
+                g: &mut sc.g,
+            };
+            en.element.load_derivatives(&ctx, &mut lj);
+        }
+        // The inertial part at the accelerations of this state: −∂(M q̈ + C + g)/∂q at fixed
+        // q̈ and v, by forward differences of inverse dynamics (stiff loads make q̈ large,
+        // and with it the change of M q̈ with the pose).
+        sc.xdot.resize(n, 0.0);
+        match xdot {
+            Some(f) => sc.xdot.copy_from_slice(f),
+            None => {
+                let mut xdot = std::mem::take(&mut sc.xdot);
+                let derivative = self.derivative(ws, t, x, &mut xdot);
+                sc.xdot = xdot;
+                if let Err(e) = derivative {
+                    ws.jacobian = sc;
+                    return Err(e);
+                }
+            }
+        }
+        {
+            let qdd = &sc.xdot[nv..2 * nv];
+            let data = sc.data.get_or_insert_with(|| Data::new(&self.model));
+            sc.qp.clear();
+            sc.qp.extend_from_slice(&ws.q);
+            rnea_pass(
+                &self.model,
+                data,
+                Some(&sc.qp),
+                Some(&ws.v),
+                Some(qdd),
+                None,
+                Output::Tau,
+            );
+            sc.tau0.clear();
+            sc.tau0.extend_from_slice(data.tau.as_slice());
+            for j in (0..nv).filter(|&j| !self.mask[j]) {
+                let qj = ws.q[j];
+                sc.qp[j] = qj + 1e-7 * (1.0 + qj.abs());
+                let h = sc.qp[j] - qj;
+                rnea_pass(
+                    &self.model,
+                    data,
+                    Some(&sc.qp),
+                    Some(&ws.v),
+                    Some(qdd),
+                    None,
+                    Output::Tau,
+                );
+                for i in 0..nv {
+                    sc.dtau[(i, j)] -= (data.tau[i] - sc.tau0[i]) / h;
+                }
+                sc.qp[j] = qj;
+            }
+            // And −∂C/∂v, the velocity products, the same way.
+            sc.vp.clear();
+            sc.vp.extend_from_slice(&ws.v);
+            for j in (0..nv).filter(|&j| !self.mask[j]) {
+                let vj = ws.v[j];
+                sc.vp[j] = vj + 1e-7 * (1.0 + vj.abs());
+                let h = sc.vp[j] - vj;
+                rnea_pass(
+                    &self.model,
+                    data,
+                    Some(&ws.q),
+                    Some(&sc.vp),
+                    Some(qdd),
+                    None,
+                    Output::Tau,
+                );
+                for i in 0..nv {
+                    sc.dtau[(i, nv + j)] -= (data.tau[i] - sc.tau0[i]) / h;
+                }
+                sc.vp[j] = vj;
+            }
+        }
+        // The free block of the mass matrix, factored.
+        crba_pass(&self.model, &mut ws.data, &ws.q);
+        sc.free.clear();
+        sc.free.extend((0..nv).filter(|&k| !self.mask[k]));
+        let nf = sc.free.len();
+        for (a, &i) in sc.free.iter().enumerate() {
+            for (b, &j) in sc.free.iter().enumerate() {
+                sc.chol[a * nf + b] = ws.data.mass_matrix[(i, j)];
+            }
+        }
+        if !cholesky_in_place(&mut sc.chol[..nf * nf], nf) {
+            ws.jacobian = sc;
+            return Err(CoreError::NonFiniteOutput {
+                t,
+                source_name: "mass matrix".into(),
+                quantity: "positive-definite factor",
+            });
+        }
+        for &k in &sc.free {
+            jac[(k, nv + k)] = 1.0;
+        }
+        for c in 0..n {
+            if sc.outside[c] {
+                continue;
+            }
+            let mut any = false;
+            for (a, &i) in sc.free.iter().enumerate() {
+                sc.rhs[a] = sc.dtau[(i, c)];
+                any |= sc.rhs[a] != 0.0;
+            }
+            if !any {
+                continue;
+            }
+            cholesky_solve(&sc.chol[..nf * nf], nf, &mut sc.rhs[..nf]);
+            for (a, &i) in sc.free.iter().enumerate() {
+                jac[(nv + i, c)] = sc.rhs[a];
+            }
+        }
+        for k in (0..nv).filter(|&k| self.mask[k]) {
+            jac.as_mut_slice()[k * n..(k + 1) * n].fill(0.0);
+            jac.as_mut_slice()[(nv + k) * n..(nv + k + 1) * n].fill(0.0);
+        }
+        // `v · 0` is NaN exactly for a non-finite `v`: one vectorizable sum per column.
+        let bad = (0..n).filter(|&c| !sc.outside[c]).find(|&c| {
+            let col = &jac.as_slice()[c * n..(c + 1) * n];
+            !col.iter().fold(0.0, |acc, v| acc + v * 0.0).is_finite()
+        });
+        ws.jacobian = sc;
+        if let Some(c) = bad {
+            return Err(CoreError::NonFiniteOutput {
+                t,
+                source_name: format!("Jacobian column of {}", self.state_meaning(c)),
+                quantity: "derivative",
+            });
+        }
+        Ok(())
+    }
+
+    /// [`System::states_outside_jacobian`] without collecting.
+    fn states_outside_ranges(&self) -> impl Iterator<Item = Range<usize>> + '_ {
+        self.entries.iter().filter_map(|en| {
+            let local = en.element.states_outside_jacobian();
+            let len = en.states.len();
+            let (a, b) = (local.start.min(len), local.end.min(len));
+            (a < b).then(|| en.states.start + a..en.states.start + b)
+        })
+    }
+
     /// Re-evaluates the elements one at a time to name the one producing non-finite loads
     /// (cold path: only after a failure).
     fn find_bad_element(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> CoreError {
@@ -682,5 +968,47 @@ impl System {
             gravity: potential_energy_from_poses(&self.model, &ws.data),
             elastic,
         })
+    }
+}
+
+/// Cholesky factor `L` (lower, row-major, in place) of the symmetric `n × n` matrix `a`;
+/// `false` when it is not positive definite.
+fn cholesky_in_place(a: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let mut d = a[j * n + j];
+        for k in 0..j {
+            d -= a[j * n + k] * a[j * n + k];
+        }
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * n + j] = d;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / d;
+        }
+    }
+    true
+}
+
+/// Solves `L Lᵀ y = b` in place with the factor of [`cholesky_in_place`].
+fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
+    for i in 0..n {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= l[i * n + k] * b[k];
+        }
+        b[i] = s / l[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..n {
+            s -= l[k * n + i] * b[k];
+        }
+        b[i] = s / l[i * n + i];
     }
 }

