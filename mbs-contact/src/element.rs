@@ -366,7 +366,9 @@ impl ForceElement for Contact {
 
     /// The normal law's `∂F_n/∂δ`, `∂F_n/∂δ̇` (closed form where the law has one, else
     /// central differences) and the friction law's `∂F_t/∂F_n`, `∂F_t/∂slip` (central
-    /// differences), through the gap `δ = −n·Δ` and the slip `t·Δ̇` at the contact point.
+    /// differences), through the gap `δ = −n·Δ` and the slip `t·Δ̇` at the contact point,
+    /// and the convective part of the gap rate (the nearest points found again a short
+    /// time ahead along the motion).
     fn load_derivatives(&self, ctx: &ForceContext<'_>, jac: &mut LoadJacobian<'_>) {
         let p = self.proximity(ctx);
         if p.gap.is_nan() || p.gap >= 0.0 {
@@ -407,6 +409,19 @@ impl ForceElement for Contact {
         }
         jac.set_point(self.sides[0].body, self.sides[1].body, out.point);
         jac.add_point_force(dq, dv);
+        // The gap rate's convective part: F changes by c_n ∂δ̇/∂q = −c_n ∂ġ/∂q along
+        // `dir`, with ∂ġ/∂q from the nearest points a short time ahead.
+        if cn != 0.0 {
+            let ahead = jac.ahead(ctx).map(|(c, _)| self.find_proximity(&c));
+            if let Some(p1) = ahead {
+                let mid = [
+                    0.5 * (p1.point_a[0] + p1.point_b[0]),
+                    0.5 * (p1.point_a[1] + p1.point_b[1]),
+                ];
+                let [a, b] = [self.sides[0].body, self.sides[1].body];
+                jac.add_gap_rate_convection(a, b, n, mid, p1.normal, dir, -cn);
+            }
+        }
     }
 
     fn position_len(&self) -> usize {

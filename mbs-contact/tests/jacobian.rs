@@ -115,6 +115,34 @@ fn the_contact_stiffness_and_damping_match_differences() {
 }
 
 #[test]
+fn the_gap_rate_convection_is_in_the_coordinate_columns() {
+    // The disc slides under the bar at 0.3 m/s while the bar turns so that the gap closes at
+    // 0.5 mm/s, inside the felt's hysteresis switch (v_ε = 1 mm/s, as the piano's): there
+    // the force depends steeply on the gap rate, and the gap rate on the pose through the
+    // sliding (the bar's normal turns under the moving disc).
+    let sys = disc_under_bar(HystereticFelt::new(2e7, 1.5, 0.4, 1e-3).unwrap(), false);
+    let e = 0;
+    let mut ws = sys.workspace();
+    let gap_rate = |ws: &mut Workspace, w: f64| {
+        let x = [0.45, 0.3377, 0.3, w];
+        let ctx = sys.element_context(ws, 0.0, &x, e).unwrap();
+        let c = sys.elements().next().and_then(Contact::of).unwrap();
+        c.output(&ctx).gap_rate
+    };
+    let (g0, g1) = (gap_rate(&mut ws, 0.0), gap_rate(&mut ws, 1.0));
+    let w = (-5e-4 - g0) / (g1 - g0);
+    let x = [0.45, 0.3377, 0.3, w];
+    assert!((gap_rate(&mut ws, w) + 5e-4).abs() < 1e-9);
+    let mut ja = DMatrix::zeros(4, 4);
+    sys.jacobian(&mut ws, 0.0, &x, &mut ja).unwrap();
+    let jf = fd_jacobian(&sys, &mut ws, &x);
+    for c in 0..4 {
+        let e = column_error(&ja, &jf, c);
+        assert!(e < 1e-2, "column {c}: {e:.2e}\n{ja}\n{jf}");
+    }
+}
+
+#[test]
 fn apart_the_contact_adds_nothing() {
     let sys = disc_under_bar(HystereticFelt::new(2e7, 1.5, 0.4, 1e-2).unwrap(), true);
     let mut ws = sys.workspace();

@@ -6,6 +6,7 @@ use std::ops::Range;
 use nalgebra::DMatrix;
 
 use crate::data::Data;
+use crate::force::ForceContext;
 use crate::jacobian::column;
 use crate::model::{BodyId, Model};
 
@@ -30,9 +31,12 @@ pub enum Wrt {
 /// relative to A's, and the system maps them with `G = J_B(p) − J_A(p)` to
 /// `∂τ/∂q = Gᵀ (∂F/∂Δ) G` and `∂τ/∂v = Gᵀ (∂F/∂Δ̇) G`. What this leaves out is of second
 /// order in the geometry: the turning of lever arms and normals with the pose
-/// (`∂Gᵀ/∂q · F`) and the convective part of `Δ̇` (`∂(G v)/∂q` at fixed `v`). For stiff
-/// contacts these are small beside the stiffness terms kept; they are what a
-/// linearly implicit method's Jacobian may lack without losing its order.
+/// (`∂Gᵀ/∂q · F`) and the convective part of `Δ̇` (`∂(G v)/∂q` at fixed `v`). The latter
+/// is not small where a law depends steeply on a rate (a felt's hysteresis switch: `F`
+/// changes by `∂F/∂δ̇ · ∂δ̇/∂q`), and an element adds it for its gap rate with
+/// [`LoadJacobian::add_gap_rate_convection`]; what remains (the slip's convective part, the
+/// geometric stiffness `F ∂(Gᵀ n)/∂q`) is what a linearly implicit method's Jacobian may
+/// lack without losing its order.
 pub struct LoadJacobian<'a> {
     pub(crate) model: &'a Model,
     pub(crate) data: &'a Data,
@@ -46,6 +50,10 @@ pub struct LoadJacobian<'a> {
     pub(crate) outside: &'a [bool],
     /// `G = J_B(p) − J_A(p)` of the point set last, one `[x, y]` per coordinate.
     pub(crate) g: &'a mut [[f64; 2]],
+    /// The kinematics at `q + ε v`, those coordinates, and ε (`None` at rest).
+    pub(crate) ahead: Option<(&'a Data, &'a [f64], f64)>,
+    /// Scratch: the gradient of a gap rate with respect to the coordinates.
+    pub(crate) hv: &'a mut [f64],
 }
 
 impl LoadJacobian<'_> {
@@ -149,6 +157,73 @@ impl LoadJacobian<'_> {
             }
             self.jac[(row, c)] += dq[0] * gc[0] + dq[1] * gc[1];
             self.jac[(row, nv + c)] += dv[0] * gc[0] + dv[1] * gc[1];
+        }
+    }
+}
+
+impl<'a> LoadJacobian<'a> {
+    /// The context at `q + ε v` (the poses a short time `ε` ahead along the current
+    /// velocities, velocities and states unchanged), and `ε`; `None` when nothing moves.
+    /// An element reads there what its convective terms need: how a pose-dependent
+    /// quantity changes along the motion (see [`LoadJacobian::add_gap_rate_convection`]).
+    pub fn ahead<'c>(&'c self, ctx: &ForceContext<'c>) -> Option<(ForceContext<'c>, f64)> {
+        let (data, q, eps) = self.ahead?;
+        let ahead = ForceContext {
+            model: self.model,
+            data,
+            t: ctx.t,
+            q,
+            v: ctx.v,
+            states: ctx.states,
+            positions: &[],
+        };
+        Some((ahead, eps))
+    }
+
+    /// Adds the convective part of a contact's gap rate to the coordinate columns: for a
+    /// force on B (−on A) along `dir` that changes by `coef` per unit of the gap rate
+    /// `ġ = a(q)·v`, `a = Gᵀ n` the gradient of the gap, it adds `Gᵀ dir · coef · ∂ġ/∂q`
+    /// at the point of [`LoadJacobian::set_point`]. Since `a` is a gradient, `∂ġ/∂q` is
+    /// its Hessian times `v`, the derivative of `a` along the motion:
+    /// `(a(q + εv) − a(q))/ε`, from the normal `n` here and the contact point `p_ahead`
+    /// and normal `n_ahead` found in [`LoadJacobian::ahead`]. Does nothing at rest.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_gap_rate_convection(
+        &mut self,
+        a: BodyId,
+        b: BodyId,
+        n: [f64; 2],
+        p_ahead: [f64; 2],
+        n_ahead: [f64; 2],
+        dir: [f64; 2],
+        coef: f64,
+    ) {
+        let Some((data, _, eps)) = self.ahead else {
+            return;
+        };
+        let nv = self.model.nv();
+        for k in 0..nv {
+            self.hv[k] = -(self.g[k][0] * n[0] + self.g[k][1] * n[1]);
+        }
+        for (body, sign) in [(b, 1.0), (a, -1.0)] {
+            for j in self.model.support(body) {
+                let (_, lin) = column(self.model, data, j, p_ahead);
+                let k = self.model.bodies[j.0].idx_v;
+                self.hv[k] += sign * (lin[0] * n_ahead[0] + lin[1] * n_ahead[1]);
+            }
+        }
+        for k in 0..nv {
+            self.hv[k] /= eps;
+        }
+        for r in 0..nv {
+            let gr = self.g[r];
+            let u = coef * (gr[0] * dir[0] + gr[1] * dir[1]);
+            if u == 0.0 {
+                continue;
+            }
+            for c in 0..nv {
+                self.dtau[(r, c)] += u * self.hv[c];
+            }
         }
     }
 }

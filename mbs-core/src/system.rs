@@ -121,6 +121,11 @@ struct JacobianScratch {
     vp: Vec<f64>,
     tau0: Vec<f64>,
     data: Option<Data>,
+    /// The kinematics at `q + ε v` ([`LoadJacobian::ahead`]), those coordinates, and the
+    /// scratch of a gap rate's gradient.
+    ahead: Option<Data>,
+    q_ahead: Vec<f64>,
+    hv: Vec<f64>,
 }
 
 impl Workspace {
@@ -580,13 +585,15 @@ impl System {
     ///
     /// It is not the exact derivative. Left out are the geometric terms listed on
     /// [`LoadJacobian`]
-    /// (lever arms and normals turning with the pose, the convective part of a contact's
-    /// gap rate), which touch the coordinate columns only. On the piano action's loud
-    /// keystroke the velocity columns agree with central differences to 1e-3
-    /// (`piano-action/tests/jacobian.rs`); the coordinate columns can be off by much more
-    /// where a contact's rate-dependent law is steep, through the convective term. A Newton
-    /// iteration or a Rosenbrock–W method keeps its order with such a matrix; how many
-    /// steps it costs depends on what is missing.
+    /// that the elements do not add (lever arms and normals turning with the pose, a slip's
+    /// convective part), which touch the coordinate columns only. On the piano action's
+    /// loud keystroke the velocity columns agree with central differences to 1e-3
+    /// (`piano-action/tests/jacobian.rs`); the coordinate columns of the levers whose
+    /// contacts slide under friction can be off by tens of per cent. A Newton iteration or
+    /// a Rosenbrock–W method keeps its order with such a matrix; how many steps it costs
+    /// depends on what is missing (without the gap rate's convective part, a Rosenbrock
+    /// method needed 1 219 steps for the loud keystroke; with it, 751, as many as with
+    /// finite differences at every step).
     ///
     /// The columns of [`System::states_outside_jacobian`] are not written: the caller keeps
     /// them zero (they are zero in this Jacobian). Errors: wrong shape, a bad state, an
@@ -660,6 +667,18 @@ impl System {
                 jac.as_mut_slice()[c * n..(c + 1) * n].fill(0.0);
             }
         }
+        // The poses a short time ahead along the velocities, for the elements' convective
+        // terms: ε moves no coordinate by more than 1e-7 (rad or m).
+        let v_max = ws.v.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let eps = if v_max > 0.0 { 1e-7 / v_max } else { 0.0 };
+        if eps > 0.0 {
+            sc.q_ahead.clear();
+            sc.q_ahead
+                .extend(ws.q.iter().zip(&ws.v).map(|(q, v)| q + eps * v));
+            let d = sc.ahead.get_or_insert_with(|| Data::new(&self.model));
+            kinematics_pass(&self.model, d, &sc.q_ahead, Some(&ws.v));
+        }
+        sc.hv.resize(nv, 0.0);
         for en in &self.entries {
             let ctx = self.context(
                 &ws.data,
@@ -669,7 +688,13 @@ impl System {
                 &x[en.states.clone()],
                 &ws.positions[en.positions.clone()],
             );
+            let ahead = match (&sc.ahead, eps > 0.0) {
+                (Some(d), true) => Some((d, sc.q_ahead.as_slice(), eps)),
+                _ => None,
+            };
             let mut lj = LoadJacobian {
+                ahead,
+                hv: &mut sc.hv,
                 model: &self.model,
                 data: &ws.data,
                 dtau: &mut sc.dtau,

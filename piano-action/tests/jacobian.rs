@@ -1,8 +1,8 @@
 //! The action's own Jacobian (`System::jacobian`, what the integrator uses) against central
 //! differences of its derivative, on the states of a loud keystroke's first 50 ms: the
 //! velocity columns throughout, and the string's modal rows while the hammer is on the
-//! string. (The coordinate columns leave out the contacts' geometric terms, see
-//! `mbs_core::LoadJacobian`, so they are not compared.)
+//! string. (The coordinate columns leave out the slips' convective part and the contacts'
+//! geometric stiffness, see `mbs_core::LoadJacobian`, so they are not compared.)
 
 use nalgebra::DMatrix;
 use piano_action::simulate::prepare;
