@@ -1,39 +1,16 @@
 //! The `Contact` force element in an `mbs_core::System`: action and reaction, the gap as
 //! switching function, per-contact output, profiles, ground contacts.
 
-use mbs_contact::laws::NormalLaw;
 use mbs_contact::{Contact, ContactSide, Shape};
 use mbs_core::{BodySpec, Force, ForceElement, JointKind, Loads, ModelBuilder, Placement, System};
 
-/// A linear spring law for these tests: F = k δ.
-#[derive(Debug)]
-struct Linear(f64);
+mod common;
 
-impl NormalLaw for Linear {
-    fn force(&self, delta: f64, _rate: f64, _s: &[f64], _r: &mut [f64]) -> f64 {
-        if delta > 0.0 { self.0 * delta } else { 0.0 }
-    }
-}
+use common::Linear;
 
-/// Two free-ish bodies: a slider carrying a disc, and a pendulum carrying a bar.
+/// A slider carrying a disc, and a pendulum carrying a bar, under gravity.
 fn two_bodies() -> mbs_core::Model {
-    let mut b = ModelBuilder::new();
-    b.gravity([0.0, -9.81])
-        .add_link(
-            "slider",
-            None,
-            JointKind::Prismatic { axis: [1.0, 0.0] },
-            Placement::default(),
-            BodySpec::new(0.5, [0.0, 0.0], 1e-3),
-        )
-        .add_link(
-            "arm",
-            None,
-            JointKind::Revolute,
-            Placement::offset(0.3, 0.0),
-            BodySpec::rod(0.2, 0.4),
-        );
-    b.build().unwrap()
+    common::slider_and_arm([0.0, -9.81])
 }
 
 #[test]

@@ -3,40 +3,18 @@
 
 use mbs_contact::laws::{HystereticFelt, NormalLaw, RegularizedCoulomb};
 use mbs_contact::{Contact, ContactSide, Shape};
-use mbs_core::{BodySpec, JointKind, ModelBuilder, Placement, System, Workspace};
+use mbs_core::{System, Workspace};
 use nalgebra::DMatrix;
 
-/// A linear spring law with no closed-form derivatives (the contact differentiates it).
-#[derive(Debug)]
-struct Linear(f64);
+mod common;
 
-impl NormalLaw for Linear {
-    fn force(&self, delta: f64, _rate: f64, _s: &[f64], _r: &mut [f64]) -> f64 {
-        if delta > 0.0 { self.0 * delta } else { 0.0 }
-    }
-}
+use common::Linear;
 
 /// A slider carrying a disc under a lever carrying a bar, no gravity: the mass matrix is
 /// constant and there are no velocity products, so what the Jacobian leaves out is the
 /// contact's geometry only.
 fn disc_under_bar(law: impl NormalLaw + 'static, friction: bool) -> System {
-    let mut b = ModelBuilder::new();
-    b.gravity([0.0, 0.0])
-        .add_link(
-            "slider",
-            None,
-            JointKind::Prismatic { axis: [1.0, 0.0] },
-            Placement::default(),
-            BodySpec::new(0.5, [0.0, 0.0], 1e-3),
-        )
-        .add_link(
-            "arm",
-            None,
-            JointKind::Revolute,
-            Placement::offset(0.3, 0.0),
-            BodySpec::rod(0.2, 0.4),
-        );
-    let model = b.build().unwrap();
+    let model = common::slider_and_arm([0.0, 0.0]);
     let disc = Shape::circle([0.0, 0.0], 0.05).unwrap();
     let face = Shape::segment([0.4, 0.0], [0.0, 0.0]).unwrap();
     let mut contact = Contact::new(

@@ -680,14 +680,7 @@ impl System {
         }
         sc.hv.resize(nv, 0.0);
         for en in &self.entries {
-            let ctx = self.context(
-                &ws.data,
-                &ws.q,
-                &ws.v,
-                t,
-                &x[en.states.clone()],
-                &ws.positions[en.positions.clone()],
-            );
+            let ctx = self.entry_context(ws, t, x, en);
             let ahead = match (&sc.ahead, eps > 0.0) {
                 (Some(d), true) => Some((d, sc.q_ahead.as_slice(), eps)),
                 _ => None,
@@ -706,8 +699,8 @@ impl System {
             en.element.load_derivatives(&ctx, &mut lj);
         }
         // The inertial part at the accelerations of this state: −∂(M q̈ + C + g)/∂q at fixed
-        // q̈ and v, by forward differences of inverse dynamics (stiff loads make q̈ large,
-        // and with it the change of M q̈ with the pose).
+        // q̈ and v, and −∂C/∂v, by forward differences of inverse dynamics (stiff loads make
+        // q̈ large, and with it the change of M q̈ with the pose).
         sc.xdot.resize(n, 0.0);
         match xdot {
             Some(f) => sc.xdot.copy_from_slice(f),
@@ -724,57 +717,38 @@ impl System {
         {
             let qdd = &sc.xdot[nv..2 * nv];
             let data = sc.data.get_or_insert_with(|| Data::new(&self.model));
+            let inverse_dynamics = |data: &mut Data, q: &[f64], v: &[f64]| {
+                rnea_pass(
+                    &self.model,
+                    data,
+                    Some(q),
+                    Some(v),
+                    Some(qdd),
+                    None,
+                    Output::Tau,
+                );
+            };
             sc.qp.clear();
             sc.qp.extend_from_slice(&ws.q);
-            rnea_pass(
-                &self.model,
-                data,
-                Some(&sc.qp),
-                Some(&ws.v),
-                Some(qdd),
-                None,
-                Output::Tau,
-            );
+            inverse_dynamics(data, &sc.qp, &ws.v);
             sc.tau0.clear();
             sc.tau0.extend_from_slice(data.tau.as_slice());
-            for j in (0..nv).filter(|&j| !self.mask[j]) {
-                let qj = ws.q[j];
-                sc.qp[j] = qj + 1e-7 * (1.0 + qj.abs());
-                let h = sc.qp[j] - qj;
-                rnea_pass(
-                    &self.model,
-                    data,
-                    Some(&sc.qp),
-                    Some(&ws.v),
-                    Some(qdd),
-                    None,
-                    Output::Tau,
-                );
-                for i in 0..nv {
-                    sc.dtau[(i, j)] -= (data.tau[i] - sc.tau0[i]) / h;
-                }
-                sc.qp[j] = qj;
-            }
-            // And −∂C/∂v, the velocity products, the same way.
+            // Each free coordinate, then each free velocity, moved in turn.
             sc.vp.clear();
             sc.vp.extend_from_slice(&ws.v);
-            for j in (0..nv).filter(|&j| !self.mask[j]) {
-                let vj = ws.v[j];
-                sc.vp[j] = vj + 1e-7 * (1.0 + vj.abs());
-                let h = sc.vp[j] - vj;
-                rnea_pass(
-                    &self.model,
-                    data,
-                    Some(&ws.q),
-                    Some(&sc.vp),
-                    Some(qdd),
-                    None,
-                    Output::Tau,
-                );
-                for i in 0..nv {
-                    sc.dtau[(i, nv + j)] -= (data.tau[i] - sc.tau0[i]) / h;
+            for (velocity, offset) in [(false, 0), (true, nv)] {
+                for j in (0..nv).filter(|&j| !self.mask[j]) {
+                    let moved = if velocity { &mut sc.vp } else { &mut sc.qp };
+                    let old = moved[j];
+                    moved[j] = old + 1e-7 * (1.0 + old.abs());
+                    let h = moved[j] - old;
+                    inverse_dynamics(data, &sc.qp, &sc.vp);
+                    for i in 0..nv {
+                        sc.dtau[(i, offset + j)] -= (data.tau[i] - sc.tau0[i]) / h;
+                    }
+                    let moved = if velocity { &mut sc.vp } else { &mut sc.qp };
+                    moved[j] = old;
                 }
-                sc.vp[j] = vj;
             }
         }
         // The free block of the mass matrix, factored.
