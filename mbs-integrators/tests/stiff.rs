@@ -251,6 +251,18 @@ fn tr_bdf2_van_der_pol_matches_the_test_set() {
     }
     // Without finite differences it needs fewer derivative evaluations.
     assert!(sols[1].stats.derivative_evals < sols[0].stats.derivative_evals);
+    // With the system's own Jacobian every evaluation is a Newton iteration but for the
+    // start (f at t0 and the automatic first step's trial) and the step-start rate each
+    // Jacobian is taken with: a converged stage takes its rate from the stage equation,
+    // not from one more evaluation.
+    let s = &sols[1].stats;
+    assert!(
+        s.derivative_evals <= s.newton_iterations + s.jacobian_evals + 2,
+        "{} evaluations for {} Newton iterations and {} Jacobians",
+        s.derivative_evals,
+        s.newton_iterations,
+        s.jacobian_evals
+    );
 }
 
 #[test]
