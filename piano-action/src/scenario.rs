@@ -851,7 +851,21 @@ pub fn write_run_dir(
         .iter()
         .map(|e| serde_json::json!({"name": e.name, "time_s": e.time_s}))
         .collect();
-    write_json(dir, "events.json", &serde_json::Value::from(events.clone()))?;
+    write_json(dir, "events.json", &serde_json::Value::from(events))?;
+    let summary = run_summary(run);
+    write_json(dir, "summary.json", &summary)?;
+    Ok(())
+}
+
+/// The summary of a grand run, as `summary.json` has it: the model, the strikes (time,
+/// hammer speed, contact duration, rebound speed, pulses), the key-start, travel, let-off,
+/// key-bottom and check times, the key bottom less the string contact, and the events.
+pub fn run_summary(run: &Run) -> serde_json::Value {
+    let events: Vec<serde_json::Value> = run
+        .events
+        .iter()
+        .map(|e| serde_json::json!({"name": e.name, "time_s": e.time_s}))
+        .collect();
     let strikes: Vec<serde_json::Value> = run
         .strikes
         .iter()
@@ -865,7 +879,7 @@ pub fn write_run_dir(
             })
         })
         .collect();
-    let summary = serde_json::json!({
+    serde_json::json!({
         "model": run.kind.name(),
         "strikes": strikes,
         "key_start_time_s": num(run.key_start_time_s),
@@ -879,9 +893,7 @@ pub fn write_run_dir(
         ),
         "check_time_s": num(run.check_time_s),
         "events": events,
-    });
-    write_json(dir, "summary.json", &summary)?;
-    Ok(())
+    })
 }
 
 /// Writes `trajectory.csv` (time, then `<name>_q` and `<name>_v` for every coordinate in

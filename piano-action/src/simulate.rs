@@ -420,16 +420,9 @@ pub fn prepare(params: &ActionParams, kind: ModelKind, input: &Input) -> Result<
     prepare_transformed(params, kind, input, None)
 }
 
-/// Assembles like [`prepare`], the grand's description changed by `transform` if given
-/// (an effect a diagnosis adds); the rest is then settled on the changed action.
-pub fn prepare_transformed(
-    params: &ActionParams,
-    kind: ModelKind,
-    input: &Input,
-    transform: Option<Transform<'_>>,
-) -> Result<Prepared> {
-    input.validate()?;
-    let presser = match *input {
+/// The body an input puts on the key front (a mass, a finger), if any.
+fn presser_for(input: &Input) -> Option<Presser> {
+    match *input {
         Input::MassDrop { mass_kg, height_m } => Some(Presser::weight(mass_kg, height_m * 1e3)),
         Input::Touch { style, finger } => Some(Presser {
             mass_kg: finger.mass_g * 1e-3,
@@ -441,7 +434,32 @@ pub fn prepare_transformed(
             carried: true,
         }),
         _ => None,
-    };
+    }
+}
+
+/// The coordinates of a run of `input` on `kind`, in the order of its states: the action's,
+/// then the presser's (`"presser"`) for a mass drop or a touch. Builds the action without
+/// settling it.
+pub fn coordinate_names(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+) -> Result<Vec<String>> {
+    input.validate()?;
+    let action = Action::build_transformed(params, kind, presser_for(input), None)?;
+    Ok(action.system.model().coordinate_names().to_vec())
+}
+
+/// Assembles like [`prepare`], the grand's description changed by `transform` if given
+/// (an effect a diagnosis adds); the rest is then settled on the changed action.
+pub fn prepare_transformed(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    transform: Option<Transform<'_>>,
+) -> Result<Prepared> {
+    input.validate()?;
+    let presser = presser_for(input);
     // Start from the action settled at rest (the presser, if any, last, with its pad where
     // the layout put it relative to the key top).
     let rest = match transform {

@@ -1,0 +1,227 @@
+"""Sweeps: one keystroke per touch level (and per parameter set), on this machine's cores or
+mapped over a Dask cluster, into one table that equals ``piano sweep``'s CSV."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+
+from . import _core
+from ._errors import InputError
+
+#: What a grid may hold (see :func:`sweep`).
+GRID_KEYS = ("touch", "values", "start", "stop", "runs", "linear", "duration_s", "model",
+             "params", "set")
+
+Progress = Union[bool, Callable[[int, int], None]]
+
+
+class SweepTable:
+    """The rows of a sweep, in the order of the grid (not of completion).
+
+    ``header`` is the list of column names: the parameter paths of the grid's ``set``, if
+    any, then ``piano sweep``'s columns. ``to_csv()`` gives the text ``piano sweep`` writes
+    for the same levels (with the parameter columns in front when ``set`` was given).
+    """
+
+    def __init__(self, header: List[str], lines: List[str]):
+        self.header = header
+        self._lines = lines
+
+    def __len__(self) -> int:
+        return len(self._lines)
+
+    def __repr__(self) -> str:
+        failed = len(self.errors())
+        return f"SweepTable({len(self)} rows, {failed} failed)"
+
+    def to_csv(self) -> str:
+        """The table as CSV text, header first, one line per run, ending in a newline."""
+        return ",".join(self.header) + "\n" + "".join(line + "\n" for line in self._lines)
+
+    def records(self) -> List[Dict[str, Any]]:
+        """One dict per row: numbers as floats (``strikes`` an int), empty cells as None,
+        ``touch``, ``unit`` and ``error`` as strings (``error`` None for a run that
+        worked)."""
+        out = []
+        for line in self._lines:
+            cells = line.split(",", len(self.header) - 1)
+            out.append({name: _cell(name, cell) for name, cell in zip(self.header, cells)})
+        return out
+
+    def column(self, name: str):
+        """A column as a numpy array of floats (NaN where empty); ``touch``, ``unit`` and
+        ``error`` as a list of strings."""
+        import numpy as np
+
+        if name not in self.header:
+            raise InputError(f"no column '{name}' (columns: {', '.join(self.header)})")
+        values = [r[name] for r in self.records()]
+        if name in ("touch", "unit", "error"):
+            return values
+        return np.array([math.nan if v is None else float(v) for v in values])
+
+    def errors(self) -> List[Tuple[int, str]]:
+        """The rows whose run failed: (row index, why)."""
+        return [(i, r["error"]) for i, r in enumerate(self.records()) if r["error"]]
+
+    def to_pandas(self):
+        """The table as a pandas DataFrame (pandas must be installed)."""
+        import pandas as pd
+
+        return pd.DataFrame.from_records(self.records(), columns=self.header)
+
+
+def _cell(name: str, cell: str) -> Any:
+    if name in ("touch", "unit"):
+        return cell
+    if name == "error":
+        return cell or None
+    if cell == "":
+        return None
+    if name == "strikes":
+        return int(cell)
+    return float(cell)
+
+
+def _task(touch: str, value: float, duration_s: float, model: str,
+          params: Optional[_core.Params]) -> str:
+    """One row: what a Dask worker runs (module-level, so it pickles by reference)."""
+    return _core.sweep_row(touch, value, duration_s, model, params)
+
+
+def _expand(grid: Mapping[str, Any]):
+    """The grid's tasks: (parameter values, touch, level, duration, model, params)."""
+    if not isinstance(grid, Mapping):
+        raise InputError(f"a sweep grid is a dict, got {type(grid).__name__}")
+    unknown = sorted(set(grid) - set(GRID_KEYS))
+    if unknown:
+        raise InputError(f"unknown grid key(s) {', '.join(unknown)} "
+                         f"(known: {', '.join(GRID_KEYS)})")
+    touch = grid.get("touch", "struck")
+    if "values" in grid:
+        for k in ("start", "stop", "runs", "linear"):
+            if k in grid:
+                raise InputError(f"give either 'values' or '{k}', not both")
+        values = [float(v) for v in grid["values"]]
+        if not values:
+            raise InputError("'values' is empty: a sweep needs at least one level")
+        _core.check_sweep_levels(touch, values)
+    else:
+        values = _core.sweep_levels(touch, grid.get("start"), grid.get("stop"),
+                                    int(grid.get("runs", 100)), bool(grid.get("linear", False)))
+    duration_s = float(grid.get("duration_s", 0.3))
+    model = grid.get("model", "double")
+    base = grid.get("params") or _core.Params()
+    if not isinstance(base, _core.Params):
+        raise InputError(f"'params' is a piano_action.Params, got {type(base).__name__}")
+    settings: Mapping[str, Sequence[float]] = grid.get("set") or {}
+    paths = list(settings)
+    combos: Iterable[Tuple[float, ...]] = itertools.product(
+        *[[float(v) for v in settings[p]] for p in paths]) if paths else [()]
+    tasks = []
+    for combo in combos:
+        params = base
+        if paths:
+            params = base.copy()
+            for p, v in zip(paths, combo):
+                params.set(p, v)  # raises InputError naming the path or the value
+        for value in values:
+            tasks.append((combo, touch, value, duration_s, model, params))
+    return paths, tasks
+
+
+def sweep(grid: Mapping[str, Any], client: Any = None, progress: Progress = True,
+          workers: Optional[int] = None) -> SweepTable:
+    """Runs one keystroke per point of ``grid`` and returns the table.
+
+    ``grid`` is a dict:
+
+    - ``touch``: ``"force"`` (constant key-front force, N), ``"pressed"`` (peak force of a
+      pressed touch, N) or ``"struck"`` (finger speed, m/s); ``"struck"`` by default;
+    - the levels: ``values`` (a list), or ``start``, ``stop``, ``runs`` and ``linear`` as
+      ``piano sweep``'s ``--from``, ``--to``, ``--runs`` and ``--linear`` (same defaults);
+    - ``duration_s`` (0.3 s by default) and ``model`` (``"double"`` by default);
+    - ``params``: a :class:`Params` (the reference by default);
+    - ``set``: ``{parameter path: [values]}``; every combination is run at every level
+      (parameter sets outer, levels inner), its values in the first columns.
+
+    With ``client`` (a ``dask.distributed.Client``: a ``LocalCluster`` on a laptop, or a
+    Slurm or PBS cluster from ``dask-jobqueue``), each keystroke is one task on the
+    cluster; without it, the keystrokes run on this machine's threads (``workers``, one per
+    core by default). Rows come back as they finish (``progress``: True prints a progress
+    line to stderr, a callable gets ``(done, total)``, False nothing) and are put in the
+    grid's order. A run that fails, or a task the cluster loses, fails its own row (the
+    ``error`` column says why); the others go on. The numbers equal ``piano sweep``'s to
+    the bit.
+    """
+    paths, tasks = _expand(grid)
+    total = len(tasks)
+    lines: List[Optional[str]] = [None] * total
+    report = _progress_reporter(progress, total)
+
+    def done(i: int, line: str) -> None:
+        combo = tasks[i][0]
+        prefix = "".join(f"{_fmt(v)}," for v in combo)
+        lines[i] = prefix + line
+
+    if client is None:
+        n = workers or os.cpu_count() or 1
+        with ThreadPoolExecutor(max_workers=n) as pool:
+            futures = {pool.submit(_task, *t[1:]): i for i, t in enumerate(tasks)}
+            from concurrent.futures import as_completed
+
+            for k, fut in enumerate(as_completed(futures), 1):
+                i = futures[fut]
+                done(i, _line_or_failure(tasks[i], fut.result, Exception))
+                report(k)
+    else:
+        from distributed import as_completed
+
+        touches, values, durations, models, params = zip(*[t[1:] for t in tasks])
+        futures = client.map(_task, touches, values, durations, models, params, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        for k, fut in enumerate(as_completed(futures), 1):
+            i = index[fut.key]
+            done(i, _line_or_failure(tasks[i], fut.result, BaseException))
+            report(k)
+    header = paths + _core.sweep_header().split(",")
+    return SweepTable(header, [line for line in lines if line is not None])
+
+
+def _line_or_failure(task, result: Callable[[], str], catch) -> str:
+    """The task's row, or a failed row saying why (a wrong argument raises)."""
+    try:
+        return result()
+    except InputError:
+        raise
+    except catch as e:  # a lost worker, a killed task: this row fails, not the sweep
+        _, touch, value, _, _, _ = task
+        return _core.sweep_failed_row(touch, value, f"{type(e).__name__}: {e}")
+
+
+def _fmt(v: float) -> str:
+    return _core.format_number(v)
+
+
+def _progress_reporter(progress: Progress, total: int) -> Callable[[int], None]:
+    if callable(progress):
+        return lambda k: progress(k, total)
+    if not progress:
+        return lambda k: None
+    step = max(1, total // 50)
+
+    def report(k: int) -> None:
+        if k % step == 0 or k == total:
+            width = 30
+            filled = width * k // total
+            sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {k}/{total} runs")
+            if k == total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    return report

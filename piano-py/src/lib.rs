@@ -1,0 +1,804 @@
+//! `piano_action._core`: the Python extension module of the `piano_action` package.
+//!
+//! It wraps `piano-action` as it is: parameter files, scenarios, keystrokes and sweep rows
+//! run the same code as the `piano` command line, so the numbers are the same to the bit.
+//! The pure-Python part of the package (`python/piano_action/`) adds the Dask sweep and
+//! the command line. Errors become `piano_action.InputError` (a `ValueError` carrying the
+//! file, line and field), `piano_action.PianoFileError` (an `OSError`) or
+//! `piano_action.SimulationError` (a `RuntimeError`), all subclasses of
+//! `piano_action.PianoError`. Simulations run with the GIL released.
+
+use std::path::PathBuf;
+
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use piano_action::scenario::{InputSpec, Scenario};
+use piano_action::simulate::{Run, prepare, simulate as simulate_input};
+use piano_action::sweep::{SweepKind, SweepRow, check_levels, csv, levels};
+use piano_action::{ActionParams, ModelKind, PianoError};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+// The exceptions are defined in Python (`python/piano_action/_errors.py`), so that they
+// can also be a `ValueError`, an `OSError` or a `RuntimeError`.
+pyo3::import_exception!(piano_action._errors, InputError);
+pyo3::import_exception!(piano_action._errors, PianoFileError);
+pyo3::import_exception!(piano_action._errors, SimulationError);
+
+/// The Python exception for `e`, with its attributes set: `kind`, `file`, `line`, `field`
+/// and `message` (None where they do not apply).
+fn to_py(e: PianoError) -> PyErr {
+    Python::attach(|py| {
+        let text = e.to_string();
+        let (err, kind, file, line, field, message) = match &e {
+            PianoError::Input(i) => (
+                InputError::new_err(text.clone()),
+                Some(i.kind.label().to_string()),
+                i.file.as_ref().map(|p| p.display().to_string()),
+                i.line,
+                Some(i.field.clone()).filter(|f| !f.is_empty()),
+                i.message.clone(),
+            ),
+            PianoError::UnknownParameter { path, .. } => (
+                InputError::new_err(text.clone()),
+                Some("parameter path".to_string()),
+                None,
+                None,
+                Some(path.clone()),
+                text.clone(),
+            ),
+            PianoError::File { path, message } => (
+                PianoFileError::new_err(text.clone()),
+                None,
+                Some(path.display().to_string()),
+                None,
+                None,
+                message.clone(),
+            ),
+            PianoError::Io { path, .. } => (
+                PianoFileError::new_err(text.clone()),
+                None,
+                Some(path.display().to_string()),
+                None,
+                None,
+                text.clone(),
+            ),
+            _ => (
+                SimulationError::new_err(text.clone()),
+                None,
+                None,
+                None,
+                None,
+                text.clone(),
+            ),
+        };
+        let value = err.value(py);
+        // Setting attributes on a fresh exception instance cannot fail in practice; if it
+        // did, the message still says everything.
+        let _ = value.setattr("kind", kind);
+        let _ = value.setattr("file", file);
+        let _ = value.setattr("line", line);
+        let _ = value.setattr("field", field);
+        let _ = value.setattr("message", message);
+        err
+    })
+}
+
+/// An option of a function (`touch`, `model`, `runs`...) with a wrong value.
+fn option_error(option: &str, message: String) -> PyErr {
+    to_py(PianoError::option(option, message))
+}
+
+/// A set of action parameters: the embedded reference, or a parameter file.
+#[pyclass(module = "piano_action._core", name = "Params", from_py_object)]
+#[derive(Clone)]
+struct Params {
+    inner: ActionParams,
+    /// The file it was read from, for `paths()`'s source tags and error messages.
+    file: Option<PathBuf>,
+    /// The text it was read from (None for the reference, whose text is embedded).
+    text: Option<String>,
+}
+
+#[pymethods]
+impl Params {
+    /// The reference parameters (the embedded defaults, as `piano` without `--params`).
+    #[new]
+    fn new() -> Self {
+        Params {
+            inner: ActionParams::reference(),
+            file: None,
+            text: None,
+        }
+    }
+
+    /// Reads a parameter file; errors name the file, the line and the field.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| to_py(PianoError::io(&path, "read the parameter file", e)))?;
+        let inner = ActionParams::from_toml_str(&text).map_err(|e| to_py(e.in_file(&path)))?;
+        Ok(Params {
+            inner,
+            file: Some(path),
+            text: Some(text),
+        })
+    }
+
+    /// Parses parameters from TOML text (the parameter file's format).
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        let inner = ActionParams::from_toml_str(text).map_err(to_py)?;
+        Ok(Params {
+            inner,
+            file: None,
+            text: Some(text.to_string()),
+        })
+    }
+
+    /// The parameters as TOML text (a parameter file).
+    fn to_toml(&self) -> PyResult<String> {
+        self.inner.to_toml_string().map_err(to_py)
+    }
+
+    /// The value at a parameter path (`hammer.mass_g`, `jack.toe_mm[1]`; `paths()` lists
+    /// them).
+    fn get(&self, path: &str) -> PyResult<f64> {
+        self.inner.parameter(path).map_err(to_py)
+    }
+
+    /// Sets the value at a parameter path; the parameters are checked again, and a value
+    /// that makes them invalid is refused (the parameters stay as they were).
+    fn set(&mut self, path: &str, value: f64) -> PyResult<()> {
+        let mut changed = self.inner.clone();
+        changed.set_parameter(path, value).map_err(to_py)?;
+        changed.validate().map_err(to_py)?;
+        self.inner = changed;
+        // The text no longer says the same; tags are still read from it by `paths()`.
+        Ok(())
+    }
+
+    /// Every numeric parameter: a list of `(path, value, unit, tags)`, tags being the
+    /// source tags on its line of the parameter file (`[S]`, `[M]`, `[regulated]`, ...).
+    fn paths(&self) -> PyResult<Vec<(String, f64, String, String)>> {
+        let source = match &self.text {
+            Some(t) => t.clone(),
+            None => piano_action::params::DEFAULT_PARAMS_TOML.to_string(),
+        };
+        let list = self.inner.parameter_list(&source).map_err(to_py)?;
+        Ok(list
+            .into_iter()
+            .map(|p| (p.path, p.value, p.unit.to_string(), p.tags))
+            .collect())
+    }
+
+    /// A copy (`set` on it leaves this one as it is).
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    /// The file these parameters were read from, if any.
+    #[getter]
+    fn file(&self) -> Option<String> {
+        self.file.as_ref().map(|p| p.display().to_string())
+    }
+
+    fn __repr__(&self) -> String {
+        match &self.file {
+            Some(f) => format!("Params.load({:?})", f.display().to_string()),
+            None if self.text.is_some() => "Params.from_toml(...)".to_string(),
+            None => "Params()".to_string(),
+        }
+    }
+
+    /// Pickling (Dask sends parameters to its workers): the TOML text, which gives back
+    /// the same values to the bit.
+    fn __getstate__(&self) -> PyResult<(String, Option<String>, Option<String>)> {
+        Ok((
+            self.to_toml()?,
+            self.file.as_ref().map(|p| p.display().to_string()),
+            self.text.clone(),
+        ))
+    }
+
+    fn __setstate__(&mut self, state: (String, Option<String>, Option<String>)) -> PyResult<()> {
+        self.inner = ActionParams::from_toml_str(&state.0).map_err(to_py)?;
+        self.file = state.1.map(PathBuf::from);
+        self.text = state.2;
+        Ok(())
+    }
+}
+
+/// The parameters given, or the reference.
+fn params_or_reference(params: Option<&Params>) -> ActionParams {
+    params.map_or_else(ActionParams::reference, |p| p.inner.clone())
+}
+
+/// A scenario: what drives the key, for how long, on which model (the scenario file's
+/// format; see `piano-action/scenarios/`).
+#[pyclass(module = "piano_action._core", name = "Scenario", from_py_object)]
+#[derive(Clone)]
+struct ScenarioPy {
+    inner: Scenario,
+    file: Option<PathBuf>,
+}
+
+#[pymethods]
+impl ScenarioPy {
+    /// Reads a scenario file (and a motion's CSV beside it); errors name the file, the
+    /// line and the field.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let inner = Scenario::load(&path).map_err(to_py)?;
+        Ok(ScenarioPy {
+            inner,
+            file: Some(path),
+        })
+    }
+
+    /// Parses a scenario from TOML text.
+    #[staticmethod]
+    fn from_toml(text: &str) -> PyResult<Self> {
+        let inner = Scenario::from_toml_str(text).map_err(to_py)?;
+        Ok(ScenarioPy { inner, file: None })
+    }
+
+    /// The scenario as TOML text.
+    fn to_toml(&self) -> PyResult<String> {
+        toml::to_string(&self.inner).map_err(|e| {
+            to_py(PianoError::scenario(
+                "",
+                format!("cannot write as TOML: {e}"),
+            ))
+        })
+    }
+
+    /// The model (`simplified`, `single` or `double`; empty for a mechanism scenario).
+    #[getter]
+    fn model(&self) -> String {
+        self.inner.model.clone()
+    }
+
+    /// Simulated time (s).
+    #[getter]
+    fn duration_s(&self) -> f64 {
+        self.inner.duration_s
+    }
+
+    /// Output grid spacing (s).
+    #[getter]
+    fn output_step_s(&self) -> f64 {
+        self.inner.output_step_s
+    }
+
+    /// The file it was read from, if any.
+    #[getter]
+    fn file(&self) -> Option<String> {
+        self.file.as_ref().map(|p| p.display().to_string())
+    }
+
+    fn __repr__(&self) -> String {
+        match &self.file {
+            Some(f) => format!("Scenario.load({:?})", f.display().to_string()),
+            None => format!(
+                "Scenario(model={:?}, duration_s={})",
+                self.inner.model, self.inner.duration_s
+            ),
+        }
+    }
+}
+
+/// Something that happened in a keystroke (`let_off`, `string_contact_start`, ...).
+#[pyclass(module = "piano_action._core", frozen, get_all)]
+#[derive(Clone)]
+struct Event {
+    /// What happened.
+    name: String,
+    /// When (s).
+    time_s: f64,
+}
+
+#[pymethods]
+impl Event {
+    fn __repr__(&self) -> String {
+        format!("Event({:?}, time_s={})", self.name, self.time_s)
+    }
+}
+
+/// One blow of the hammer on the string.
+#[pyclass(module = "piano_action._core", frozen, get_all)]
+#[derive(Clone)]
+struct Strike {
+    /// Start of string contact (s).
+    time_s: f64,
+    /// Speed of the strike point at contact (m/s).
+    hammer_velocity_m_s: f64,
+    /// From first touch to last release (s), if the hammer left the string in the run.
+    contact_duration_s: Option<f64>,
+    /// Speed of the strike point leaving the string (m/s), if it did.
+    rebound_velocity_m_s: Option<f64>,
+    /// Contact pulses in the blow (1 for a clean blow).
+    pulses: usize,
+}
+
+#[pymethods]
+impl Strike {
+    fn __repr__(&self) -> String {
+        format!(
+            "Strike(time_s={}, hammer_velocity_m_s={})",
+            self.time_s, self.hammer_velocity_m_s
+        )
+    }
+}
+
+/// The result of a keystroke on a grand model: arrays on the output grid, the events, the
+/// strikes and the times a technician reads.
+#[pyclass(module = "piano_action._core", name = "Run")]
+struct RunPy {
+    run: Run,
+    params: ActionParams,
+    scenario: Scenario,
+    names: Vec<String>,
+}
+
+#[pymethods]
+impl RunPy {
+    /// `simplified`, `single` or `double`.
+    #[getter]
+    fn model(&self) -> &'static str {
+        self.run.kind.name()
+    }
+
+    /// Output times (s), shape `(n,)`.
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.run.solution.t.clone())
+    }
+
+    /// The coordinates' names (the columns of `q` and `v`).
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+
+    /// Coordinates (rad for joints, m for the key's presser), shape `(n, coordinates)`.
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.columns(py, 0, self.names.len())
+    }
+
+    /// Velocities, shape `(n, coordinates)`.
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let nv = self.names.len();
+        self.columns(py, nv, 2 * nv)
+    }
+
+    /// The whole state (coordinates, velocities, then the force elements' internal states
+    /// such as the string's modal amplitudes), shape `(n, states)`.
+    #[getter]
+    fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.columns(py, 0, self.run.solution.n)
+    }
+
+    /// The force driving the key front (N) at each output time, for inputs that have one
+    /// (touches); None otherwise.
+    #[getter]
+    fn key_drive_force_n<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        let f = &self.run.key_drive_force_n;
+        (f.len() == self.run.solution.len() && !f.is_empty())
+            .then(|| PyArray1::from_vec(py, f.clone()))
+    }
+
+    /// The events, in time order.
+    #[getter]
+    fn events(&self) -> Vec<Event> {
+        self.run
+            .events
+            .iter()
+            .map(|e| Event {
+                name: e.name.to_string(),
+                time_s: e.time_s,
+            })
+            .collect()
+    }
+
+    /// The blows of the hammer on the string.
+    #[getter]
+    fn strikes(&self) -> Vec<Strike> {
+        self.run
+            .strikes
+            .iter()
+            .map(|s| Strike {
+                time_s: s.time_s,
+                hammer_velocity_m_s: s.hammer_velocity_m_s,
+                contact_duration_s: s.contact_duration_s,
+                rebound_velocity_m_s: s.rebound_velocity_m_s,
+                pulses: s.pulses,
+            })
+            .collect()
+    }
+
+    /// When the key front has gone down 0.1 mm (s).
+    #[getter]
+    fn key_start_time_s(&self) -> Option<f64> {
+        self.run.key_start_time_s
+    }
+
+    /// From key start to string contact (s).
+    #[getter]
+    fn travel_time_s(&self) -> Option<f64> {
+        self.run.travel_time_s
+    }
+
+    /// Let-off: the jack tripped by its button (s).
+    #[getter]
+    fn let_off_time_s(&self) -> Option<f64> {
+        self.run.let_off_time_s
+    }
+
+    /// The key reaching its front-rail punching (s).
+    #[getter]
+    fn key_bottom_time_s(&self) -> Option<f64> {
+        self.run.key_bottom_time_s
+    }
+
+    /// The hammer caught by the backcheck (s).
+    #[getter]
+    fn check_time_s(&self) -> Option<f64> {
+        self.run.check_time_s
+    }
+
+    /// The integrator's work: steps, rejected steps, derivative and Jacobian evaluations,
+    /// LU decompositions, Newton iterations and failures, event evaluations.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.run.solution.stats;
+        let d = PyDict::new(py);
+        d.set_item("steps", s.steps)?;
+        d.set_item("rejected", s.rejected)?;
+        d.set_item("derivative_evals", s.derivative_evals)?;
+        d.set_item("jacobian_evals", s.jacobian_evals)?;
+        d.set_item("lu_decompositions", s.lu_decompositions)?;
+        d.set_item("newton_iterations", s.newton_iterations)?;
+        d.set_item("newton_failures", s.newton_failures)?;
+        d.set_item("event_evals", s.event_evals)?;
+        Ok(d)
+    }
+
+    /// The summary, as `summary.json` of `piano simulate` has it (a dict).
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let value = piano_action::scenario::run_summary(&self.run);
+        json_to_py(py, &value)
+    }
+
+    /// Every contact on the output grid, as `contacts.csv` of `piano simulate` has it: a
+    /// dict from the contact's name to a dict of arrays `gap_mm`, `force_n`, `px_mm`,
+    /// `py_mm`, `nx`, `ny` and `active` (bool). Computed on the first call (it rebuilds the
+    /// action at rest, a few milliseconds), with the GIL released.
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (params, scenario, run) = (&self.params, &self.scenario, &self.run);
+        let table = py
+            .detach(|| {
+                let input = scenario.input.to_input()?;
+                let prepared = prepare(params, run.kind, &input)?;
+                let action = &prepared.action;
+                let sol = &run.solution;
+                let mut out = Vec::new();
+                for name in action.contacts.keys() {
+                    let mut cols: [Vec<f64>; 6] = Default::default();
+                    let mut active = Vec::with_capacity(sol.len());
+                    for i in 0..sol.len() {
+                        let o = action.contact_output(name, sol.t[i], sol.state(i))?;
+                        let vals = [
+                            o.gap * 1e3,
+                            o.normal_force,
+                            o.point[0] * 1e3,
+                            o.point[1] * 1e3,
+                            o.normal[0],
+                            o.normal[1],
+                        ];
+                        for (c, v) in cols.iter_mut().zip(vals) {
+                            c.push(v);
+                        }
+                        active.push(o.active);
+                    }
+                    out.push((name.clone(), cols, active));
+                }
+                Ok::<_, PianoError>(out)
+            })
+            .map_err(to_py)?;
+        let d = PyDict::new(py);
+        for (name, cols, active) in table {
+            let c = PyDict::new(py);
+            let keys = ["gap_mm", "force_n", "px_mm", "py_mm", "nx", "ny"];
+            for (k, col) in keys.into_iter().zip(cols) {
+                c.set_item(k, PyArray1::from_vec(py, col))?;
+            }
+            c.set_item("active", PyArray1::from_vec(py, active))?;
+            d.set_item(name, c)?;
+        }
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Run(model={:?}, points={}, strikes={})",
+            self.run.kind.name(),
+            self.run.solution.len(),
+            self.run.strikes.len()
+        )
+    }
+}
+
+impl RunPy {
+    /// Columns `from..to` of the states as an `(n, to − from)` array.
+    fn columns<'py>(
+        &self,
+        py: Python<'py>,
+        from: usize,
+        to: usize,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let sol = &self.run.solution;
+        let mut data = Vec::with_capacity(sol.len() * (to - from));
+        for i in 0..sol.len() {
+            data.extend_from_slice(&sol.state(i)[from..to]);
+        }
+        let a = Array2::from_shape_vec((sol.len(), to - from), data)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py))
+    }
+}
+
+/// A JSON value as Python objects (dicts, lists, floats, ints, str, None).
+fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use serde_json::Value;
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        Value::Number(n) => match (n.as_u64(), n.as_i64(), n.as_f64()) {
+            (Some(u), _, _) => u.into_pyobject(py)?.into_any(),
+            (None, Some(i), _) => i.into_pyobject(py)?.into_any(),
+            (None, None, Some(f)) => f.into_pyobject(py)?.into_any(),
+            _ => py.None().into_bound(py),
+        },
+        Value::String(s) => s.into_pyobject(py)?.into_any(),
+        Value::Array(a) => {
+            let list = PyList::empty(py);
+            for x in a {
+                list.append(json_to_py(py, x)?)?;
+            }
+            list.into_any()
+        }
+        Value::Object(o) => {
+            let d = PyDict::new(py);
+            for (k, x) in o {
+                d.set_item(k, json_to_py(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+/// Runs a scenario on a grand model; a scenario with a mechanism description or the
+/// swing test is refused with a message saying so (the command line runs them).
+fn run_scenario(py: Python<'_>, scenario: ScenarioPy, params: ActionParams) -> PyResult<RunPy> {
+    let s = &scenario.inner;
+    if s.mechanism.is_some() {
+        return Err(to_py(PianoError::scenario(
+            "mechanism",
+            "a scenario with a mechanism description is run by `piano simulate`; from \
+             Python, only the grand models (simplified, single, double) so far",
+        )));
+    }
+    if let InputSpec::Pendulum(_) = s.input {
+        return Err(to_py(PianoError::scenario(
+            "input.kind",
+            "the hammer swing test is run by `piano simulate`; from Python, keystrokes \
+             only so far",
+        )));
+    }
+    let kind = s.model_kind().map_err(to_py)?;
+    let input = s.input.to_input().map_err(to_py)?;
+    let names = piano_action::simulate::coordinate_names(&params, kind, &input).map_err(to_py)?;
+    let run = py.detach(|| s.run(&params)).map_err(|e| {
+        to_py(match &scenario.file {
+            // Scenario::run's errors are the simulation's, or a value of the file.
+            Some(f) => e.in_file(f),
+            None => e,
+        })
+    })?;
+    Ok(RunPy {
+        run,
+        params,
+        scenario: scenario.inner,
+        names,
+    })
+}
+
+/// Simulates `scenario` (a `Scenario`, a path to a scenario file, or a dict in the
+/// scenario file's shape) with `params` (the reference by default), as `piano simulate`
+/// does: the same numbers to the bit. The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (scenario, params=None))]
+fn simulate(
+    py: Python<'_>,
+    scenario: &Bound<'_, PyAny>,
+    params: Option<Params>,
+) -> PyResult<RunPy> {
+    let scenario = scenario_from(py, scenario)?;
+    run_scenario(py, scenario, params_or_reference(params.as_ref()))
+}
+
+/// A `Scenario` from what `simulate` accepts.
+fn scenario_from(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<ScenarioPy> {
+    if let Ok(s) = obj.extract::<ScenarioPy>() {
+        return Ok(s);
+    }
+    if obj.is_instance_of::<PyDict>() {
+        // Through JSON into TOML text, so the file's own checks (and field paths) apply.
+        let json = py.import("json")?.call_method1("dumps", (obj,))?;
+        let text: String = json.extract()?;
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| to_py(PianoError::scenario("", format!("not a scenario: {e}"))))?;
+        let toml_text = toml::to_string(&value).map_err(|e| {
+            to_py(PianoError::scenario(
+                "",
+                format!("cannot be written as a scenario: {e}"),
+            ))
+        })?;
+        let inner = Scenario::from_toml_str(&toml_text).map_err(|e| {
+            to_py(match e {
+                // Lines of the TOML made from the dict mean nothing to the caller.
+                PianoError::Input(mut i) => {
+                    i.line = None;
+                    PianoError::Input(i)
+                }
+                other => other,
+            })
+        })?;
+        return Ok(ScenarioPy { inner, file: None });
+    }
+    if let Ok(path) = obj.extract::<PathBuf>() {
+        return ScenarioPy::load(path);
+    }
+    Err(to_py(PianoError::scenario(
+        "",
+        format!(
+            "expected a Scenario, a path to a scenario file or a dict, got {}",
+            obj.get_type().name()?
+        ),
+    )))
+}
+
+/// The kind of a sweep by its command-line name.
+fn sweep_kind(touch: &str) -> PyResult<SweepKind> {
+    [SweepKind::Force, SweepKind::Pressed, SweepKind::Struck]
+        .into_iter()
+        .find(|k| k.name() == touch)
+        .ok_or_else(|| {
+            option_error(
+                "touch",
+                format!("unknown '{touch}' (force, pressed or struck)"),
+            )
+        })
+}
+
+/// A model kind by name.
+fn model_kind(model: &str) -> PyResult<ModelKind> {
+    ModelKind::ALL
+        .into_iter()
+        .find(|k| k.name() == model)
+        .ok_or_else(|| {
+            option_error(
+                "model",
+                format!("unknown model '{model}' (simplified, single or double)"),
+            )
+        })
+}
+
+/// The levels of a sweep, as `piano sweep --touch T --from A --to B --runs N [--linear]`
+/// makes them (its defaults for A and B), each checked.
+#[pyfunction]
+#[pyo3(signature = (touch="struck", start=None, stop=None, runs=100, linear=false))]
+fn sweep_levels(
+    touch: &str,
+    start: Option<f64>,
+    stop: Option<f64>,
+    runs: usize,
+    linear: bool,
+) -> PyResult<Vec<f64>> {
+    let kind = sweep_kind(touch)?;
+    let (lo, hi) = match kind {
+        SweepKind::Force => (1.0, 40.0),
+        SweepKind::Pressed => (0.7, 50.0),
+        SweepKind::Struck => (0.08, 2.0),
+    };
+    let values = levels(start.unwrap_or(lo), stop.unwrap_or(hi), runs, !linear).map_err(to_py)?;
+    check_levels(kind, &values).map_err(to_py)?;
+    Ok(values)
+}
+
+/// Checks levels given one by one, as `sweep_levels` checks its own: each must make a
+/// valid input (a finger speed, a force in range).
+#[pyfunction]
+fn check_sweep_levels(touch: &str, values: Vec<f64>) -> PyResult<()> {
+    check_levels(sweep_kind(touch)?, &values).map_err(to_py)
+}
+
+/// The header of a sweep's CSV (`piano sweep`'s).
+#[pyfunction]
+fn sweep_header() -> &'static str {
+    piano_action::sweep::CSV_HEADER
+}
+
+/// One keystroke of a sweep: `touch` at `value` for `duration_s` on `model`, as one line
+/// of `piano sweep`'s CSV (no newline). A run that fails gives its row with the reason in
+/// the `error` column, as the command line does; a wrong argument raises. The GIL is
+/// released while it runs.
+#[pyfunction]
+#[pyo3(signature = (touch, value, duration_s=0.3, model="double", params=None))]
+fn sweep_row(
+    py: Python<'_>,
+    touch: &str,
+    value: f64,
+    duration_s: f64,
+    model: &str,
+    params: Option<Params>,
+) -> PyResult<String> {
+    let kind = sweep_kind(touch)?;
+    let model = model_kind(model)?;
+    piano_action::simulate::check_duration(duration_s, 1e-3).map_err(to_py)?;
+    check_levels(kind, &[value]).map_err(to_py)?;
+    let params = params_or_reference(params.as_ref());
+    let row = py.detach(|| SweepRow {
+        value,
+        run: simulate_input(&params, model, &kind.input(value), duration_s, 1e-3)
+            .map_err(|e| e.to_string()),
+    });
+    let text = csv(kind, &[row]);
+    Ok(text.lines().nth(1).map(str::to_string).unwrap_or_default())
+}
+
+/// The row of a run that failed for `reason` (a task a cluster lost), as `piano sweep`
+/// writes a failed run: the level, then empty cells, then the reason.
+#[pyfunction]
+fn sweep_failed_row(touch: &str, value: f64, reason: &str) -> PyResult<String> {
+    let kind = sweep_kind(touch)?;
+    let row = SweepRow {
+        value,
+        run: Err(reason.to_string()),
+    };
+    Ok(csv(kind, &[row])
+        .lines()
+        .nth(1)
+        .map(str::to_string)
+        .unwrap_or_default())
+}
+
+/// A number as the command line writes it in its CSV files (the shortest text that reads
+/// back to the same bits).
+#[pyfunction]
+fn format_number(value: f64) -> String {
+    format!("{value}")
+}
+
+/// The extension module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Params>()?;
+    m.add_class::<ScenarioPy>()?;
+    m.add_class::<RunPy>()?;
+    m.add_class::<Event>()?;
+    m.add_class::<Strike>()?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_levels, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_row, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_header, m)?)?;
+    m.add_function(wrap_pyfunction!(check_sweep_levels, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_failed_row, m)?)?;
+    m.add_function(wrap_pyfunction!(format_number, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

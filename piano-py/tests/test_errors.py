@@ -1,0 +1,87 @@
+"""Errors are Python exceptions that name the file, the line and the field."""
+
+from __future__ import annotations
+
+import pytest
+
+import piano_action as pa
+from conftest import SCENARIOS
+
+
+def test_a_wrong_scenario_file_names_file_line_and_field(tmp_path, piano):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('model = "double"\nduration_s = 0.2\n\n[input]\nkind = "force"\n'
+                   'force_n = -5.0\n')
+    with pytest.raises(pa.InputError) as info:
+        pa.simulate(bad)
+    e = info.value
+    assert isinstance(e, ValueError) and isinstance(e, pa.PianoError)
+    assert e.file == str(bad) and e.line == 6 and e.field == "input.force_n"
+    assert e.kind == "scenario"
+    # The same words as the command line's.
+    cli = piano("simulate", bad, "--out", tmp_path / "out", check=False)
+    assert cli.returncode != 0 and str(e) in cli.stderr
+
+
+def test_a_wrong_parameter_file(tmp_path):
+    text = pa.Params().to_toml().replace("mass_g = ", "mass_g = -", 1)
+    bad = tmp_path / "params.toml"
+    bad.write_text(text)
+    with pytest.raises(pa.InputError) as info:
+        pa.Params.load(bad)
+    e = info.value
+    assert e.file == str(bad) and e.line is not None and e.field.endswith("mass_g")
+    assert text.splitlines()[e.line - 1].lstrip().startswith("mass_g = -")
+
+
+def test_a_missing_file_is_an_os_error(tmp_path):
+    with pytest.raises(pa.PianoFileError) as info:
+        pa.simulate(tmp_path / "nowhere.toml")
+    assert isinstance(info.value, OSError)
+    assert info.value.file == str(tmp_path / "nowhere.toml")
+
+
+def test_a_wrong_dict_names_the_field_without_a_line():
+    with pytest.raises(pa.InputError) as info:
+        pa.simulate({"model": "double", "duration_s": 0.2,
+                     "input": {"kind": "touch", "style": "pressed", "peak_force_nn": 3.0}})
+    e = info.value
+    assert e.line is None and "peak_force_nn" in str(e)
+    with pytest.raises(pa.InputError) as info:
+        pa.simulate({"model": "upright", "duration_s": 0.2,
+                     "input": {"kind": "force", "force_n": 3.0}})
+    assert info.value.field == "model"
+    with pytest.raises(pa.InputError):
+        pa.simulate(42)
+
+
+def test_parameters_refuse_what_the_file_would():
+    p = pa.Params()
+    with pytest.raises(pa.InputError) as info:
+        p.set("hammer.mass_gg", 10.0)
+    assert "hammer.mass_g" in str(info.value)  # the suggestion
+    before = p.get("hammer.mass_g")
+    with pytest.raises(pa.InputError) as info:
+        p.set("hammer.mass_g", -1.0)
+    assert info.value.field == "hammer.mass_g"
+    assert p.get("hammer.mass_g") == before  # unchanged
+
+
+def test_absurd_durations_and_levels():
+    with pytest.raises(pa.InputError) as info:
+        pa.simulate({"model": "double", "duration_s": 1e9,
+                     "input": {"kind": "force", "force_n": 3.0}})
+    assert info.value.field == "duration_s"
+    with pytest.raises(pa.InputError):
+        pa.sweep_row("struck", float("nan"))
+    with pytest.raises(pa.InputError) as info:
+        pa.sweep_row("tickled", 1.0)
+    assert "force, pressed or struck" in str(info.value)
+    with pytest.raises(pa.InputError):
+        pa.sweep({"touch": "pressed", "values": [1.0, -3.0]})
+
+
+def test_not_yet_from_python_says_so():
+    with pytest.raises(pa.InputError) as info:
+        pa.simulate(SCENARIOS / "pendulum.toml")
+    assert "piano simulate" in str(info.value)

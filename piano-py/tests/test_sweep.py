@@ -1,0 +1,96 @@
+"""`sweep` equals `piano sweep`, on this machine's threads and on a Dask LocalCluster."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import cloudpickle
+import numpy as np
+import pytest
+
+import piano_action as pa
+import piano_action._sweep as sweep_module
+
+ARGS = dict(touch="pressed", start=1.0, stop=30.0, runs=6)
+DURATION = 0.15
+
+
+@pytest.fixture(scope="module")
+def cli_csv(piano, tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep") / "sweep.csv"
+    piano("sweep", "--touch", ARGS["touch"], "--from", ARGS["start"], "--to", ARGS["stop"],
+          "--runs", ARGS["runs"], "--duration", DURATION, "--out", out)
+    return out.read_text()
+
+
+@pytest.fixture(scope="module")
+def client():
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def grid(**more):
+    return {**ARGS, "duration_s": DURATION, **more}
+
+
+def test_on_threads_equals_the_command_line(cli_csv):
+    table = pa.sweep(grid(), progress=False)
+    assert table.to_csv() == cli_csv
+    assert len(table) == ARGS["runs"]
+    speeds = table.column("hammer_velocity_m_s")
+    # A harder touch, a faster hammer (every level strikes in 0.15 s).
+    assert np.all(np.isfinite(speeds)) and np.all(np.diff(speeds) > 0)
+    assert table.errors() == []
+
+
+def test_on_a_local_cluster_of_two_workers_equals_the_command_line(cli_csv, client):
+    seen = []
+    table = pa.sweep(grid(), client=client, progress=lambda done, total: seen.append((done, total)))
+    assert table.to_csv() == cli_csv
+    assert seen == [(k, ARGS["runs"]) for k in range(1, ARGS["runs"] + 1)]
+
+
+def test_parameter_grid_on_the_cluster(client):
+    mass = pa.Params().get("hammer.mass_g")
+    table = pa.sweep({"touch": "force", "values": [10.0, 30.0], "duration_s": 0.1,
+                      "set": {"hammer.mass_g": [mass, 1.5 * mass]}}, client=client,
+                     progress=False)
+    assert table.header[0] == "hammer.mass_g"
+    rec = table.records()
+    assert [r["hammer.mass_g"] for r in rec] == [mass, mass, 1.5 * mass, 1.5 * mass]
+    assert [r["value"] for r in rec] == [10.0, 30.0, 10.0, 30.0]
+    # The heavier hammer is slower at the same force.
+    assert rec[2]["hammer_velocity_m_s"] < rec[0]["hammer_velocity_m_s"]
+    assert rec[3]["hammer_velocity_m_s"] < rec[1]["hammer_velocity_m_s"]
+    # Each row as a run of its own would give it.
+    heavy = pa.Params()
+    heavy.set("hammer.mass_g", 1.5 * mass)
+    alone = pa.sweep_row("force", 30.0, 0.1, "double", heavy)
+    assert table.to_csv().splitlines()[4] == f"{pa._core.format_number(1.5 * mass)},{alone}"
+
+
+def _failing_task(touch, value, duration_s, model, params):
+    if value == 2.0:
+        raise RuntimeError("worker lost")
+    return pa.sweep_row(touch, value, duration_s, model, params)
+
+
+def test_a_failed_task_fails_its_own_row(client, monkeypatch):
+    # The task function travels by value, so the workers run this one.
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    monkeypatch.setattr(sweep_module, "_task", _failing_task)
+    for c in (None, client):
+        table = pa.sweep({"touch": "force", "values": [1.5, 2.0, 3.0], "duration_s": 0.05},
+                         client=c, progress=False)
+        assert len(table) == 3
+        assert table.errors() == [(1, "RuntimeError: worker lost")]
+        rec = table.records()
+        assert rec[1]["value"] == 2.0 and rec[1]["strikes"] == 0
+        assert rec[0]["error"] is None and rec[2]["error"] is None
+        assert math.isnan(table.column("key_start_s")[1])
