@@ -16,6 +16,9 @@
 use std::path::PathBuf;
 use std::process::{Command, ExitCode};
 
+mod harness;
+use harness::Outcome;
+
 use piano_action::ActionParams;
 use piano_action::report::write_report;
 use piano_action::scenario::{Scenario, write_run_dir};
@@ -23,68 +26,13 @@ use piano_action::scenario::{Scenario, write_run_dir};
 const NAME: &str = "the_report_works_in_headless_chromium";
 
 fn main() -> ExitCode {
-    if !selected(std::env::args().skip(1).collect()) {
-        return ExitCode::SUCCESS;
-    }
-    println!("\nrunning 1 test (browser)");
-    let outcome = run();
-    let (word, code) = match &outcome {
-        Outcome::Passed => ("ok", ExitCode::SUCCESS),
-        Outcome::Skipped(_) => ("SKIPPED", ExitCode::SUCCESS),
-        Outcome::Failed(_) => ("FAILED", ExitCode::FAILURE),
-    };
-    println!("test {NAME} ... {word}");
-    match outcome {
-        Outcome::Passed => {}
-        Outcome::Skipped(why) => println!(
-            "    SKIPPED: {why}\n    (see .ci/run: apt-get install chromium; npm ci --prefix \
-             piano-action/tests/browser; set PIANO_BROWSER_TESTS=required to make this a failure)"
-        ),
-        Outcome::Failed(why) => println!("\n{why}"),
-    }
-    println!();
-    code
-}
-
-/// Whether the command line (as `cargo test` passes it on to every test binary) selects
-/// this test: the libtest options that matter here are honoured (`FILTER`, `--exact`,
-/// `--skip PATTERN`, `--ignored`, `--list`), the others are ignored.
-fn selected(args: Vec<String>) -> bool {
-    let (mut filters, mut skips) = (Vec::new(), Vec::new());
-    let (mut exact, mut ignored_only) = (false, false);
-    let mut args = args.into_iter();
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--list" => {
-                println!("{NAME}: test");
-                return false;
-            }
-            "--exact" => exact = true,
-            "--ignored" => ignored_only = true,
-            "--skip" => skips.extend(args.next()),
-            "--test-threads" | "--format" | "--color" | "--logfile" | "-Z" | "--shuffle-seed" => {
-                args.next();
-            }
-            _ if a.starts_with('-') => {}
-            _ => filters.push(a),
-        }
-    }
-    let matches = |f: &String| {
-        if exact {
-            NAME == f
-        } else {
-            NAME.contains(f.as_str())
-        }
-    };
-    !ignored_only
-        && (filters.is_empty() || filters.iter().any(matches))
-        && !skips.iter().any(|s| NAME.contains(s.as_str()))
-}
-
-enum Outcome {
-    Passed,
-    Skipped(String),
-    Failed(String),
+    harness::main(
+        NAME,
+        "browser",
+        "see .ci/run: apt-get install chromium; npm ci --prefix piano-action/tests/browser; set \
+         PIANO_BROWSER_TESTS=required to make this a failure",
+        run,
+    )
 }
 
 fn run() -> Outcome {
@@ -100,8 +48,7 @@ fn run() -> Outcome {
     .flatten()
     .collect();
     if !missing.is_empty() {
-        let required = std::env::var("PIANO_BROWSER_TESTS").is_ok_and(|v| v == "required")
-            || std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false");
+        let required = harness::required("PIANO_BROWSER_TESTS");
         let why = format!("the browser test needs {}", missing.join(", "));
         return if required {
             Outcome::Failed(format!(

@@ -54,6 +54,12 @@ def test_on_a_local_cluster_of_two_workers_equals_the_command_line(cli_csv, clie
     table = pa.sweep(grid(), client=client, progress=lambda done, total: seen.append((done, total)))
     assert table.to_csv() == cli_csv
     assert seen == [(k, ARGS["runs"]) for k in range(1, ARGS["runs"] + 1)]
+    # Several keystrokes per task: the same table.
+    seen.clear()
+    table = pa.sweep(grid(), client=client, batch=4,
+                     progress=lambda done, total: seen.append(done))
+    assert table.to_csv() == cli_csv
+    assert seen == [4, 6] or seen == [2, 6]
 
 
 def test_parameter_grid_on_the_cluster(client):
@@ -85,12 +91,31 @@ def test_a_failed_task_fails_its_own_row(client, monkeypatch):
     # The task function travels by value, so the workers run this one.
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     monkeypatch.setattr(sweep_module, "_task", _failing_task)
-    for c in (None, client):
+    for c, batch in ((None, None), (client, None), (client, 2), (client, 3)):
         table = pa.sweep({"touch": "force", "values": [1.5, 2.0, 3.0], "duration_s": 0.05},
-                         client=c, progress=False)
+                         client=c, progress=False, batch=batch)
         assert len(table) == 3
         assert table.errors() == [(1, "RuntimeError: worker lost")]
         rec = table.records()
         assert rec[1]["value"] == 2.0 and rec[1]["strikes"] == 0
         assert rec[0]["error"] is None and rec[2]["error"] is None
         assert math.isnan(table.column("key_start_s")[1])
+
+
+def test_python_m_piano_action_sweep_writes_the_same_csv(cli_csv, tmp_path):
+    import subprocess
+
+    out = tmp_path / "sweep.csv"
+    cmd = [sys.executable, "-m", "piano_action", "sweep", "--touch", ARGS["touch"],
+           "--from", str(ARGS["start"]), "--to", str(ARGS["stop"]), "--runs", str(ARGS["runs"]),
+           "--duration", str(DURATION), "--out", str(out)]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert out.read_text() == cli_csv
+    # It does not overwrite what is there unless asked.
+    again = subprocess.run(cmd, capture_output=True, text=True)
+    assert again.returncode == 2 and "--force" in again.stderr
+    assert out.read_text() == cli_csv
+    bad = subprocess.run(cmd[:-2] + ["--out", str(tmp_path / "x.csv"), "--runs", "0"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "runs" in bad.stderr and "Traceback" not in bad.stderr

@@ -1,0 +1,96 @@
+"""``python -m piano_action``: the command line's ``simulate`` and ``sweep`` from Python.
+
+    python -m piano_action simulate SCENARIO.toml [--params FILE] [--json]
+    python -m piano_action sweep --touch pressed --from 1 --to 40 --runs 20 --out sweep.csv
+        [--duration 0.3] [--model double] [--params FILE] [--scheduler ADDRESS] [--force]
+
+``sweep`` writes the CSV that ``piano sweep`` writes for the same options; with
+``--scheduler`` it runs on that Dask cluster. Errors print one line naming the file, line
+and field, and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import List, Optional
+
+from . import Params, PianoError, simulate, sweep
+
+
+def _params(path: Optional[str]) -> Optional[Params]:
+    return Params.load(path) if path else None
+
+
+def _simulate(a: argparse.Namespace) -> int:
+    run = simulate(a.scenario, _params(a.params))
+    if a.json:
+        print(json.dumps(run.summary(), indent=2))
+        return 0
+    print(f"{run.model} action, {len(run.t)} output points")
+    for s in run.strikes:
+        print(f"strike at {s.time_s * 1e3:.2f} ms: hammer {s.hammer_velocity_m_s:.3f} m/s")
+    if not run.strikes:
+        print("no strike")
+    for name, t in (("let-off", run.let_off_time_s), ("check", run.check_time_s),
+                    ("key bottom", run.key_bottom_time_s)):
+        if t is not None:
+            print(f"{name} at {t * 1e3:.2f} ms")
+    return 0
+
+
+def _sweep(a: argparse.Namespace) -> int:
+    out = Path(a.out)
+    if out.exists() and not a.force:
+        raise PianoError(f"{out}: exists; choose another --out, or pass --force to replace it")
+    grid = {"touch": a.touch, "runs": a.runs, "linear": a.linear, "duration_s": a.duration,
+            "model": a.model}
+    if a.start is not None:
+        grid["start"] = a.start
+    if a.stop is not None:
+        grid["stop"] = a.stop
+    if a.params:
+        grid["params"] = Params.load(a.params)
+    client = None
+    if a.scheduler:
+        from distributed import Client
+
+        client = Client(a.scheduler)
+    table = sweep(grid, client=client)
+    out.write_text(table.to_csv())
+    print(f"{len(table)} runs, {len(table.errors())} failed; table: {out}")
+    return 0
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m piano_action", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("simulate", help="run a scenario file and print its strikes and times")
+    s.add_argument("scenario")
+    s.add_argument("--params", help="a parameter file (the reference by default)")
+    s.add_argument("--json", action="store_true", help="print the summary as JSON")
+    w = sub.add_parser("sweep", help="one keystroke per touch level, into a CSV file")
+    w.add_argument("--touch", default="struck", choices=["force", "pressed", "struck"])
+    w.add_argument("--from", dest="start", type=float)
+    w.add_argument("--to", dest="stop", type=float)
+    w.add_argument("--runs", type=int, default=100)
+    w.add_argument("--linear", action="store_true")
+    w.add_argument("--duration", type=float, default=0.3)
+    w.add_argument("--model", default="double")
+    w.add_argument("--params")
+    w.add_argument("--scheduler", help="a Dask scheduler's address (tcp://host:8786)")
+    w.add_argument("--out", required=True)
+    w.add_argument("--force", action="store_true", help="replace an existing --out")
+    a = parser.parse_args(argv)
+    try:
+        return _simulate(a) if a.command == "simulate" else _sweep(a)
+    except PianoError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
