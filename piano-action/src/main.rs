@@ -734,15 +734,9 @@ fn touchweight(params: &ActionParams, model: &str, json: bool) -> Result<(), Str
     })
     .map_err(|e| e.to_string())?;
     if json {
-        let v = serde_json::json!({
-            "down_weight_gf": w.down_weight_gf,
-            "up_weight_gf": w.up_weight_gf,
-            "balance_weight_gf": w.balance_weight_gf,
-            "friction_weight_gf": w.friction_weight_gf,
-        });
         println!(
             "{}",
-            serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
+            serde_json::to_string_pretty(&w.to_json()).map_err(|e| e.to_string())?
         );
     } else {
         println!("down weight     {:6.1} gf", w.down_weight_gf);
@@ -807,19 +801,7 @@ fn regulate(
     let r = &done.achieved;
     let g = &done.params.regulation;
     if json {
-        let v = serde_json::json!({
-            "model": kind.name(),
-            "key_dip_mm": r.key_dip_mm,
-            "blow_distance_mm": r.blow_distance_mm,
-            "let_off_mm": r.let_off_mm,
-            "drop_mm": r.drop_mm,
-            "check_mm": r.check_mm,
-            "aftertouch_mm": r.aftertouch_mm,
-            "in_band": done.out_of_band.is_empty(),
-            "out_of_band": done.out_of_band,
-            "measurements": done.measurements,
-            "settings": serde_json::to_value(g).map_err(|e| e.to_string())?,
-        });
+        let v = done.to_json(kind).map_err(|e| e.to_string())?;
         println!(
             "{}",
             serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?
@@ -1042,35 +1024,31 @@ fn diagnose(
     library: Option<&str>,
     force: bool,
 ) -> Result<(), String> {
-    use piano_action::identify::{commands, diagnose::DiagnoseOptions};
-    let experiment = mbs_identify::Dataset::load(dataset)
-        .map(|d| d.experiment)
-        .unwrap_or_default();
-    if experiment == piano_action::identify::key_drive::EXPERIMENT {
-        return diagnose_key_drive(params, dataset, out, write_params, library, force);
-    }
+    use piano_action::identify::commands::{Diagnosed, diagnose_dataset_to_disk};
     let source = match params_file {
         Some(p) => std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?,
         None => piano_action::params::DEFAULT_PARAMS_TOML.to_string(),
     };
-    let options = DiagnoseOptions {
-        library: commands::library(library).map_err(|e| e.to_string())?,
-        ..DiagnoseOptions::default()
-    };
     let bar = stage_bar();
     let progress = stage_progress(&bar);
-    let result = commands::diagnose_to_disk(
+    let result = diagnose_dataset_to_disk(
         params,
         &source,
         dataset,
-        &options,
+        library,
         out,
         write_params,
         force,
         &progress,
     );
     bar.finish_and_clear();
-    let outcome = result.map_err(|e| e.to_string())?;
+    let outcome = match result.map_err(|e| e.to_string())? {
+        Diagnosed::Pendulum(outcome) => *outcome,
+        Diagnosed::KeyDrive(d, written) => {
+            print_key_drive(&d, &written);
+            return Ok(());
+        }
+    };
     let (d, written) = (&outcome.diagnosis, &outcome.written);
     println!("decision: {}. {}", d.decision, d.summary);
     let g = &d.gap;
@@ -1120,34 +1098,12 @@ fn stage_progress(bar: &indicatif::ProgressBar) -> impl Fn(&str, f64) + Sync + '
     }
 }
 
-/// `piano diagnose` on a key-drive dataset.
-fn diagnose_key_drive(
-    params: &piano_action::params::ActionParams,
-    dataset: &std::path::Path,
-    out: &std::path::Path,
-    write_params: Option<&std::path::Path>,
-    library: Option<&str>,
-    force: bool,
-) -> Result<(), String> {
-    use piano_action::identify::{commands, key_diagnose::KeyDiagnoseOptions, key_report};
-    if write_params.is_some() {
-        return Err(
-            "option --write-params: a key-drive diagnosis names effects that change the \
-             action's mechanism (a split key, a sprung back-check), which a parameter file \
-             cannot hold; read the calibrated values and the effect in report.json"
-                .into(),
-        );
-    }
-    let options = KeyDiagnoseOptions {
-        library: commands::action_library(library).map_err(|e| e.to_string())?,
-        ..KeyDiagnoseOptions::default()
-    };
-    let bar = stage_bar();
-    let progress = stage_progress(&bar);
-    let result =
-        commands::diagnose_key_drive_to_disk(params, dataset, &options, out, force, &progress);
-    bar.finish_and_clear();
-    let (d, written) = result.map_err(|e| e.to_string())?;
+/// What `piano diagnose` prints of a key-drive diagnosis.
+fn print_key_drive(
+    d: &piano_action::identify::key_diagnose::KeyDriveDiagnosis,
+    written: &[std::path::PathBuf],
+) {
+    use piano_action::identify::key_report;
     println!("decision: {}. {}", d.decision, d.summary);
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.1}", v * 1e6));
     println!(
@@ -1158,7 +1114,7 @@ fn diagnose_key_drive(
         opt(d.heldout_after_rms_m),
         d.noise_floor_m * 1e6
     );
-    if let Some((b, a)) = key_report::post_check_gap(&d) {
+    if let Some((b, a)) = key_report::post_check_gap(d) {
         println!(
             "gap after the check's catch: {:.1} -> {:.1} um ({:.1}x)",
             b * 1e6,
@@ -1200,7 +1156,6 @@ fn diagnose_key_drive(
     for p in written {
         println!("wrote {}", p.display());
     }
-    Ok(())
 }
 
 /// `piano synth`.
@@ -1216,7 +1171,7 @@ fn synth(
     truth: &std::path::Path,
     force: bool,
 ) -> Result<(), String> {
-    use piano_action::identify::{commands, key_drive, synth};
+    use piano_action::identify::commands::{SynthRequest, synth_request_to_disk};
     let numbers = |flag: &str, text: &str| {
         text.split(',')
             .map(|r| {
@@ -1226,85 +1181,55 @@ fn synth(
             })
             .collect::<Result<Vec<_>, _>>()
     };
-    match experiment {
-        "pendulum" => {
-            if markers.is_some() {
-                return Err(
-                    "option --markers: the key drive's; a pendulum dataset tracks \
-                            the hammer's head and shank"
-                        .into(),
-                );
-            }
-        }
-        key_drive::EXPERIMENT => {
-            let effect = effect
-                .map(piano_action::identify::action_effects::ActionEffect::parse)
-                .transpose()
-                .map_err(|e| e.to_string())?;
-            let options = key_drive::KeyDriveOptions {
-                seed,
-                mass_kg: mass,
-                release_heights_m: numbers("--heights", heights)?
-                    .into_iter()
-                    .map(|h| h * 1e-3)
-                    .collect(),
-                duration_s: duration.unwrap_or(0.3),
-                effect,
-                markers: markers
-                    .map(|m| {
-                        m.split(',')
-                            .map(|s| s.trim().to_string())
-                            .filter(|s| !s.is_empty())
-                            .collect()
-                    })
-                    .unwrap_or_default(),
-                ..Default::default()
-            };
-            commands::synth_key_drive_to_disk(params, &options, out, truth, force)
-                .map_err(|e| e.to_string())?;
-            println!(
-                "dataset: {} ({} run(s) of {} s at {} fps, {} kg on the key, the key front \
-                 as the drive)\ntruth: {}",
-                out.display(),
-                options.release_heights_m.len(),
-                options.duration_s,
-                options.camera.fps,
-                options.mass_kg,
-                truth.display()
-            );
-            return Ok(());
-        }
-        other => {
-            return Err(format!(
-                "option --experiment: '{other}': 'pendulum' or 'key_drive'"
-            ));
-        }
-    }
-    let duration = duration.unwrap_or(4.0);
-    let releases_deg = numbers("--releases", releases)?;
-    let options = synth::SynthOptions {
-        effect: effect
-            .map(synth::parse_effect)
-            .transpose()
-            .map_err(|e| e.to_string())?,
+    let key_drive = experiment == piano_action::identify::key_drive::EXPERIMENT;
+    let request = SynthRequest {
+        experiment: experiment.to_string(),
+        effect: effect.map(str::to_string),
         seed,
-        releases_deg,
-        duration_s: duration,
-        ..synth::SynthOptions::default()
-    };
-    commands::synth_to_disk(params, &options, out, truth, force).map_err(|e| e.to_string())?;
-    println!(
-        "dataset: {} ({} run{} of {duration} s at {} fps)\ntruth: {}",
-        out.display(),
-        options.releases_deg.len(),
-        if options.releases_deg.len() == 1 {
-            ""
+        // Only the experiment's own list is read (a wrong other one is not an error).
+        releases_deg: if key_drive {
+            Vec::new()
         } else {
-            "s"
+            numbers("--releases", releases)?
         },
-        options.camera.fps,
-        truth.display()
-    );
+        heights_mm: if key_drive {
+            numbers("--heights", heights)?
+        } else {
+            Vec::new()
+        },
+        markers: markers.map(|m| {
+            m.split(',')
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty())
+                .collect()
+        }),
+        mass_kg: mass,
+        duration_s: duration,
+    };
+    let done =
+        synth_request_to_disk(params, &request, out, truth, force).map_err(|e| e.to_string())?;
+    if key_drive {
+        println!(
+            "dataset: {} ({} run(s) of {} s at {} fps, {} kg on the key, the key front \
+             as the drive)\ntruth: {}",
+            out.display(),
+            done.runs,
+            done.duration_s,
+            done.fps,
+            mass,
+            truth.display()
+        );
+    } else {
+        println!(
+            "dataset: {} ({} run{} of {} s at {} fps)\ntruth: {}",
+            out.display(),
+            done.runs,
+            if done.runs == 1 { "" } else { "s" },
+            done.duration_s,
+            done.fps,
+            truth.display()
+        );
+    }
     Ok(())
 }
 

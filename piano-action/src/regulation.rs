@@ -8,7 +8,7 @@ use mbs_integrators::Solution;
 use serde::Serialize;
 
 use crate::action::{Action, ModelKind};
-use crate::error::Result;
+use crate::error::{PianoError, Result};
 use crate::params::ActionParams;
 use crate::simulate::{Finger, Input, TouchStyle, key_depth_mm};
 
@@ -357,6 +357,29 @@ pub struct Regulated {
     pub measurements: usize,
     /// Quantities still outside their literature band (empty when it succeeded).
     pub out_of_band: Vec<&'static str>,
+}
+
+impl Regulated {
+    /// What was achieved and the settings, as `piano regulate --json` prints them (`kind`
+    /// names the model).
+    pub fn to_json(&self, kind: ModelKind) -> Result<serde_json::Value> {
+        let r = &self.achieved;
+        let settings = serde_json::to_value(&self.params.regulation)
+            .map_err(|e| PianoError::params("regulation", format!("cannot encode: {e}")))?;
+        Ok(serde_json::json!({
+            "model": kind.name(),
+            "key_dip_mm": r.key_dip_mm,
+            "blow_distance_mm": r.blow_distance_mm,
+            "let_off_mm": r.let_off_mm,
+            "drop_mm": r.drop_mm,
+            "check_mm": r.check_mm,
+            "aftertouch_mm": r.aftertouch_mm,
+            "in_band": self.out_of_band.is_empty(),
+            "out_of_band": self.out_of_band,
+            "measurements": self.measurements,
+            "settings": settings,
+        }))
+    }
 }
 
 /// Turns one screw (`get`/`set`, mm) until `measure` reads `target` within `tol`: steps

@@ -20,6 +20,18 @@ pub struct TouchWeight {
     pub friction_weight_gf: f64,
 }
 
+impl TouchWeight {
+    /// The four weights as JSON, as `piano touchweight --json` prints them.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "down_weight_gf": self.down_weight_gf,
+            "up_weight_gf": self.up_weight_gf,
+            "balance_weight_gf": self.balance_weight_gf,
+            "friction_weight_gf": self.friction_weight_gf,
+        })
+    }
+}
+
 /// One gram-force (N): a gram under standard gravity, 9.80665 m/s² [V] (CGPM 1901), as
 /// touchweights are quoted in grams.
 const GF: f64 = 9.80665e-3;

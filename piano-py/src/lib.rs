@@ -185,10 +185,20 @@ impl Params {
     }
 
     fn __repr__(&self) -> String {
-        match &self.file {
+        let base = match &self.file {
             Some(f) => format!("Params.load({:?})", f.display().to_string()),
             None if self.text.is_some() => "Params.from_toml(...)".to_string(),
             None => "Params()".to_string(),
+        };
+        // Whether `set` (or a regulation) changed it from what it was read as.
+        let read = match &self.text {
+            Some(t) => ActionParams::from_toml_str(t).ok(),
+            None => Some(ActionParams::reference()),
+        };
+        if read.as_ref() == Some(&self.inner) {
+            base
+        } else {
+            format!("<{base}, changed>")
         }
     }
 
@@ -784,6 +794,167 @@ fn format_number(value: f64) -> String {
     format!("{value}")
 }
 
+/// The static touchweight of `model` with `params` (a dict in grams-force: down, up,
+/// balance and friction weight), as `piano touchweight --json` prints it. The GIL is
+/// released while it runs.
+#[pyfunction]
+#[pyo3(signature = (params=None, model="double"))]
+fn touchweight<'py>(
+    py: Python<'py>,
+    params: Option<Params>,
+    model: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kind = model_kind(model)?;
+    let params = params_or_reference(params.as_ref());
+    let w = py
+        .detach(|| piano_action::touchweight::measure(&params, kind))
+        .map_err(to_py)?;
+    json_to_py(py, &w.to_json())
+}
+
+/// Regulates `model` as `piano regulate` does (punching, capstan, let-off button, drop
+/// screw, backcheck, rest rail, into the literature's bands): the dict `piano regulate
+/// --json` prints, with the regulated parameters under `"params"` (a `Params`). The GIL is
+/// released while it runs.
+#[pyfunction]
+#[pyo3(signature = (params=None, model="double"))]
+fn regulate<'py>(
+    py: Python<'py>,
+    params: Option<Params>,
+    model: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kind = model_kind(model)?;
+    let base = params_or_reference(params.as_ref());
+    let done = py
+        .detach(|| {
+            piano_action::regulation::regulate(
+                &base,
+                kind,
+                &piano_action::regulation::Targets::default(),
+            )
+        })
+        .map_err(to_py)?;
+    let out = json_to_py(py, &done.to_json(kind).map_err(to_py)?)?;
+    let regulated = Params {
+        inner: done.params,
+        file: None,
+        text: None,
+    };
+    out.set_item("params", Py::new(py, regulated)?)?;
+    Ok(out)
+}
+
+/// Runs the validation experiments against the published measurements, as `piano validate
+/// --json` does, and returns its dict (every row: the figure, the band, the source, and
+/// whether it holds). The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (params=None, model="double"))]
+fn validate<'py>(
+    py: Python<'py>,
+    params: Option<Params>,
+    model: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kind = model_kind(model)?;
+    let params = params_or_reference(params.as_ref());
+    let v = py
+        .detach(|| piano_action::validate::validate_with_known(&params, kind))
+        .map_err(to_py)?;
+    json_to_py(py, &v.to_json())
+}
+
+/// Writes a synthetic dataset with a hidden effect, as `piano synth` does: into the folder
+/// `out`, its truth into the JSON file `truth` (outside it); neither replaced unless
+/// `force`. `experiment` is `pendulum` (releases in degrees above horizontal) or
+/// `key_drive` (release heights in mm, `mass_kg` on the key, `markers` tracked). Returns
+/// what was written: runs, their length (s) and the camera's fps.
+#[pyfunction]
+#[pyo3(signature = (out, truth, experiment="pendulum", effect=None, seed=0, releases_deg=None,
+    heights_mm=None, markers=None, mass_kg=1.0, duration_s=None, params=None, force=false))]
+#[allow(clippy::too_many_arguments)]
+fn synth<'py>(
+    py: Python<'py>,
+    out: PathBuf,
+    truth: PathBuf,
+    experiment: &str,
+    effect: Option<String>,
+    seed: u64,
+    releases_deg: Option<Vec<f64>>,
+    heights_mm: Option<Vec<f64>>,
+    markers: Option<Vec<String>>,
+    mass_kg: f64,
+    duration_s: Option<f64>,
+    params: Option<Params>,
+    force: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    use piano_action::identify::commands::{SynthRequest, synth_request_to_disk};
+    let defaults = SynthRequest::default();
+    let request = SynthRequest {
+        experiment: experiment.to_string(),
+        effect,
+        seed,
+        releases_deg: releases_deg.unwrap_or(defaults.releases_deg),
+        heights_mm: heights_mm.unwrap_or(defaults.heights_mm),
+        markers,
+        mass_kg,
+        duration_s,
+    };
+    let params = params_or_reference(params.as_ref());
+    let done = py
+        .detach(|| synth_request_to_disk(&params, &request, &out, &truth, force))
+        .map_err(to_py)?;
+    let d = PyDict::new(py);
+    d.set_item("dataset", out.display().to_string())?;
+    d.set_item("truth", truth.display().to_string())?;
+    d.set_item("runs", done.runs)?;
+    d.set_item("duration_s", done.duration_s)?;
+    d.set_item("fps", done.fps)?;
+    Ok(d)
+}
+
+/// Diagnoses the dataset in the folder `dataset` as `piano diagnose` does (the swing test
+/// or the key drive, by its `experiment`), writing `report.json`, `report.md` and
+/// `report.html` into `out` (refused if it holds an earlier report, unless `force`) and, for
+/// a swing test, the corrected parameter file `write_params` if asked. `library` names the
+/// effects to try (comma-separated ids; all by default). Returns the paths written; the
+/// report itself is `report.json` (see `piano_action.diagnose`, which reads it). The GIL
+/// is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (dataset, out, params=None, library=None, write_params=None, force=false))]
+fn diagnose_to_disk(
+    py: Python<'_>,
+    dataset: PathBuf,
+    out: PathBuf,
+    params: Option<Params>,
+    library: Option<String>,
+    write_params: Option<PathBuf>,
+    force: bool,
+) -> PyResult<Vec<String>> {
+    let source = params
+        .as_ref()
+        .and_then(|p| p.text.clone())
+        .unwrap_or_else(|| piano_action::params::DEFAULT_PARAMS_TOML.to_string());
+    let base = params_or_reference(params.as_ref());
+    let done = py
+        .detach(|| {
+            piano_action::identify::commands::diagnose_dataset_to_disk(
+                &base,
+                &source,
+                &dataset,
+                library.as_deref(),
+                &out,
+                write_params.as_deref(),
+                force,
+                &|_: &str, _: f64| {},
+            )
+        })
+        .map_err(to_py)?;
+    Ok(done
+        .written()
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect())
+}
+
 /// The extension module.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -799,6 +970,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check_sweep_levels, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_failed_row, m)?)?;
     m.add_function(wrap_pyfunction!(format_number, m)?)?;
+    m.add_function(wrap_pyfunction!(touchweight, m)?)?;
+    m.add_function(wrap_pyfunction!(regulate, m)?)?;
+    m.add_function(wrap_pyfunction!(validate, m)?)?;
+    m.add_function(wrap_pyfunction!(synth, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose_to_disk, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -37,3 +37,14 @@ def piano(piano_bin):
         return done
 
     return run
+
+
+def without_timing(report):
+    """A diagnosis report without what the clock measured (`throughput`'s wall times and
+    rates), which differs from run to run; the work counts stay."""
+    out = dict(report)
+    out.pop("written", None)
+    out["throughput"] = [{k: v for k, v in stage.items()
+                          if not (k.endswith("_per_s") or k == "wall_s")}
+                         for stage in report.get("throughput", [])]
+    return out

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import sys
 
@@ -11,6 +12,7 @@ import pytest
 
 import piano_action as pa
 import piano_action._sweep as sweep_module
+from conftest import without_timing
 
 ARGS = dict(touch="pressed", start=1.0, stop=30.0, runs=6)
 DURATION = 0.15
@@ -119,3 +121,32 @@ def test_python_m_piano_action_sweep_writes_the_same_csv(cli_csv, tmp_path):
     bad = subprocess.run(cmd[:-2] + ["--out", str(tmp_path / "x.csv"), "--runs", "0"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "runs" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_diagnose_many_on_the_cluster(client, tmp_path, piano):
+    # Three datasets: a viscous flange, a clean one, and one that fails its data check.
+    data = tmp_path / "data"
+    pa.synth(data / "viscous", tmp_path / "viscous.json", effect="pivot_viscous", seed=2,
+             duration_s=2.0)
+    pa.synth(data / "clean", tmp_path / "clean.json", seed=4, duration_s=2.0)
+    pa.synth(data / "broken", tmp_path / "broken.json", seed=4, duration_s=2.0)
+    spec = json.loads((data / "broken" / "dataset.json").read_text())
+    spec["fps"] = spec["fps"] * 2  # the frames are no longer at the declared rate
+    (data / "broken" / "dataset.json").write_text(json.dumps(spec))
+    names = ["viscous", "clean", "broken"]
+    seen = []
+    table = pa.diagnose_many([data / n for n in names], tmp_path / "reports", client=client,
+                             progress=lambda done, total: seen.append(done))
+    assert seen == [1, 2, 3]
+    assert [r["dataset"] for r in table.rows] == [str(data / n) for n in names]
+    viscous, clean, broken = table.rows
+    assert viscous["decision"] == "named" and viscous["effect"] == "pivot_viscous"
+    assert viscous["fit_after_um"] < viscous["fit_before_um"]
+    assert clean["decision"] == "none" and clean["effect"] is None
+    assert broken["decision"] is None and "fps" in broken["error"]
+    assert table.errors() == [(2, broken["error"])]
+    # Each report is the command line's.
+    piano("diagnose", data / "viscous", "--out", tmp_path / "cli")
+    cli = json.loads((tmp_path / "cli" / "report.json").read_text())
+    assert without_timing(table.reports[0]) == without_timing(cli)
+    assert table.to_csv().splitlines()[0].startswith("dataset,out,experiment,decision")

@@ -39,6 +39,119 @@ pub fn synth_key_drive_to_disk(
     write_synth(out, truth, &dataset, &runs, &truth_record)
 }
 
+/// What `piano synth` is asked for: the experiment and its options, as the command line
+/// takes them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthRequest {
+    /// `pendulum` (the swing test) or `key_drive` (a mass released on the key).
+    pub experiment: String,
+    /// The hidden effect, `ID[:name=value,...]`; None for none.
+    pub effect: Option<String>,
+    /// The seed: the same seed gives the same dataset.
+    pub seed: u64,
+    /// Pendulum: release angles (° above horizontal); the first run is fitted.
+    pub releases_deg: Vec<f64>,
+    /// Key drive: release heights of the mass above the key (mm); the first is fitted.
+    pub heights_mm: Vec<f64>,
+    /// Key drive: the markers tracked (empty: all).
+    pub markers: Option<Vec<String>>,
+    /// Key drive: the mass (kg).
+    pub mass_kg: f64,
+    /// Length of each run (s); None: 4 for a pendulum, 0.3 for a key drive.
+    pub duration_s: Option<f64>,
+}
+
+impl Default for SynthRequest {
+    fn default() -> Self {
+        SynthRequest {
+            experiment: "pendulum".into(),
+            effect: None,
+            seed: 0,
+            releases_deg: vec![0.0, -35.0],
+            heights_mm: vec![0.0, 5.0],
+            markers: None,
+            mass_kg: 1.0,
+            duration_s: None,
+        }
+    }
+}
+
+/// What [`synth_request_to_disk`] wrote.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthDone {
+    /// Runs written.
+    pub runs: usize,
+    /// Length of each (s).
+    pub duration_s: f64,
+    /// The camera's frame rate.
+    pub fps: f64,
+}
+
+/// `piano synth`: writes the dataset asked for into `out` and its truth to `truth`,
+/// refusing to replace either without `force`; options that do not apply to the experiment
+/// are refused, naming the option.
+pub fn synth_request_to_disk(
+    params: &ActionParams,
+    request: &SynthRequest,
+    out: &Path,
+    truth: &Path,
+    force: bool,
+) -> Result<SynthDone> {
+    match request.experiment.as_str() {
+        "pendulum" => {
+            if request.markers.is_some() {
+                return Err(PianoError::option(
+                    "--markers",
+                    "the key drive's; a pendulum dataset tracks the hammer's head and shank",
+                ));
+            }
+            let options = SynthOptions {
+                effect: request
+                    .effect
+                    .as_deref()
+                    .map(super::synth::parse_effect)
+                    .transpose()?,
+                seed: request.seed,
+                releases_deg: request.releases_deg.clone(),
+                duration_s: request.duration_s.unwrap_or(4.0),
+                ..SynthOptions::default()
+            };
+            synth_to_disk(params, &options, out, truth, force)?;
+            Ok(SynthDone {
+                runs: options.releases_deg.len(),
+                duration_s: options.duration_s,
+                fps: options.camera.fps,
+            })
+        }
+        super::key_drive::EXPERIMENT => {
+            let effect = request
+                .effect
+                .as_deref()
+                .map(super::action_effects::ActionEffect::parse)
+                .transpose()?;
+            let options = super::key_drive::KeyDriveOptions {
+                seed: request.seed,
+                mass_kg: request.mass_kg,
+                release_heights_m: request.heights_mm.iter().map(|h| h * 1e-3).collect(),
+                duration_s: request.duration_s.unwrap_or(0.3),
+                effect,
+                markers: request.markers.clone().unwrap_or_default(),
+                ..Default::default()
+            };
+            synth_key_drive_to_disk(params, &options, out, truth, force)?;
+            Ok(SynthDone {
+                runs: options.release_heights_m.len(),
+                duration_s: options.duration_s,
+                fps: options.camera.fps,
+            })
+        }
+        other => Err(PianoError::option(
+            "--experiment",
+            format!("'{other}': 'pendulum' or 'key_drive'"),
+        )),
+    }
+}
+
 /// Writes a dataset and its truth record.
 fn write_synth(
     out: &Path,
@@ -196,6 +309,74 @@ pub fn diagnose_key_drive_to_disk(
     let d = super::key_diagnose::diagnose_key_drive(params, &dataset, options, progress)?;
     let written = super::key_report::write_key_pages(&d, dir, out, force)?;
     Ok((d, written))
+}
+
+/// What [`diagnose_dataset_to_disk`] did, by the dataset's experiment.
+#[derive(Clone, Debug)]
+pub enum Diagnosed {
+    /// A swing test (`pendulum`).
+    Pendulum(Box<Outcome>),
+    /// A key drive (`key_drive`): the diagnosis and the files written.
+    KeyDrive(Box<super::key_diagnose::KeyDriveDiagnosis>, Vec<PathBuf>),
+}
+
+impl Diagnosed {
+    /// The files written (the report's pages, and the corrected parameter file if any).
+    pub fn written(&self) -> &[PathBuf] {
+        match self {
+            Diagnosed::Pendulum(o) => &o.written,
+            Diagnosed::KeyDrive(_, w) => w,
+        }
+    }
+}
+
+/// `piano diagnose`: reads the dataset in `dir`, diagnoses it by its experiment (the swing
+/// test or the key drive) with the effects `library` names (all by default), and writes the
+/// report into `out`; `write_params` (a swing test's only) asks for the corrected parameter
+/// file, `source` being the text of the parameter file used.
+#[allow(clippy::too_many_arguments)]
+pub fn diagnose_dataset_to_disk(
+    params: &ActionParams,
+    source: &str,
+    dir: &Path,
+    library_ids: Option<&str>,
+    out: &Path,
+    write_params: Option<&Path>,
+    force: bool,
+    progress: Progress<'_>,
+) -> Result<Diagnosed> {
+    let experiment = Dataset::load(dir).map(|d| d.experiment).unwrap_or_default();
+    if experiment == super::key_drive::EXPERIMENT {
+        if write_params.is_some() {
+            return Err(PianoError::option(
+                "--write-params",
+                "a key-drive diagnosis names effects that change the action's mechanism (a \
+                 split key, a sprung back-check), which a parameter file cannot hold; read \
+                 the calibrated values and the effect in report.json",
+            ));
+        }
+        let options = super::key_diagnose::KeyDiagnoseOptions {
+            library: action_library(library_ids)?,
+            ..Default::default()
+        };
+        let (d, written) = diagnose_key_drive_to_disk(params, dir, &options, out, force, progress)?;
+        return Ok(Diagnosed::KeyDrive(Box::new(d), written));
+    }
+    let options = DiagnoseOptions {
+        library: library(library_ids)?,
+        ..DiagnoseOptions::default()
+    };
+    diagnose_to_disk(
+        params,
+        source,
+        dir,
+        &options,
+        out,
+        write_params,
+        force,
+        progress,
+    )
+    .map(|o| Diagnosed::Pendulum(Box::new(o)))
 }
 
 /// What `piano diagnose` did.

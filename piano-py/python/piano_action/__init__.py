@@ -27,15 +27,21 @@ from ._core import (
     Scenario,
     Strike,
     __version__,
+    regulate,
     simulate,
     sweep_header,
     sweep_levels,
     sweep_row,
+    synth,
+    touchweight,
+    validate,
 )
+from ._diagnose import DiagnosisTable, diagnose, diagnose_many
 from ._errors import InputError, PianoError, PianoFileError, SimulationError
 from ._sweep import SweepTable, sweep
 
 __all__ = [
+    "DiagnosisTable",
     "Event",
     "InputError",
     "Params",
@@ -47,9 +53,15 @@ __all__ = [
     "Strike",
     "SweepTable",
     "__version__",
+    "diagnose",
+    "diagnose_many",
+    "regulate",
     "simulate",
     "sweep",
     "sweep_header",
     "sweep_levels",
     "sweep_row",
+    "synth",
+    "touchweight",
+    "validate",
 ]
