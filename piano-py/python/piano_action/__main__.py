@@ -1,12 +1,17 @@
-"""``python -m piano_action``: the command line's ``simulate`` and ``sweep`` from Python.
+"""``python -m piano_action``: the command line's main commands from Python.
 
     python -m piano_action simulate SCENARIO.toml [--params FILE] [--json]
     python -m piano_action sweep --touch pressed --from 1 --to 40 --runs 20 --out sweep.csv
         [--duration 0.3] [--model double] [--params FILE] [--scheduler ADDRESS] [--force]
+    python -m piano_action touchweight | regulate | validate [--model M] [--params FILE]
+    python -m piano_action diagnose DATASET... --out DIR [--library IDS] [--params FILE]
+        [--scheduler ADDRESS] [--force]
 
-``sweep`` writes the CSV that ``piano sweep`` writes for the same options; with
-``--scheduler`` it runs on that Dask cluster. Errors print one line naming the file, line
-and field, and exit with status 2.
+``sweep`` writes the CSV that ``piano sweep`` writes for the same options; ``touchweight``,
+``regulate`` and ``validate`` print the JSON of ``piano ... --json``; ``diagnose`` writes
+each dataset's report into DIR/<dataset folder name> and prints one line per dataset.
+With ``--scheduler`` sweeps and diagnoses run on that Dask cluster. Errors print one line
+naming the file, line and field, and exit with status 2.
 """
 
 from __future__ import annotations
@@ -17,7 +22,8 @@ import sys
 from pathlib import Path
 from typing import List, Optional
 
-from . import Params, PianoError, simulate, sweep
+from . import (Params, PianoError, diagnose_many, regulate, simulate, sweep, touchweight,
+               validate)
 
 
 def _params(path: Optional[str]) -> Optional[Params]:
@@ -53,15 +59,38 @@ def _sweep(a: argparse.Namespace) -> int:
         grid["stop"] = a.stop
     if a.params:
         grid["params"] = Params.load(a.params)
-    client = None
-    if a.scheduler:
-        from distributed import Client
-
-        client = Client(a.scheduler)
-    table = sweep(grid, client=client)
+    table = sweep(grid, client=_client(a.scheduler))
     out.write_text(table.to_csv())
     print(f"{len(table)} runs, {len(table.errors())} failed; table: {out}")
     return 0
+
+
+def _client(address: Optional[str]):
+    if not address:
+        return None
+    from distributed import Client
+
+    return Client(address)
+
+
+def _analysis(a: argparse.Namespace) -> int:
+    run = {"touchweight": touchweight, "regulate": regulate, "validate": validate}[a.command]
+    result = run(_params(a.params), a.model)
+    result.pop("params", None)  # regulate's Params object (the command line's JSON has none)
+    print(json.dumps(result, indent=2))
+    return 0
+
+
+def _diagnose(a: argparse.Namespace) -> int:
+    table = diagnose_many(a.datasets, a.out, client=_client(a.scheduler), params=_params(a.params),
+                          library=a.library, force=a.force, progress=len(a.datasets) > 1)
+    for row in table.rows:
+        if row["error"]:
+            print(f"{row['dataset']}: failed: {row['error']}")
+        else:
+            effect = f" ({row['effect']})" if row["effect"] else ""
+            print(f"{row['dataset']}: {row['decision']}{effect}; report in {row['out']}")
+    return 0 if not table.errors() else 1
 
 
 def main(argv: Optional[List[str]] = None) -> int:
@@ -84,9 +113,24 @@ def main(argv: Optional[List[str]] = None) -> int:
     w.add_argument("--scheduler", help="a Dask scheduler's address (tcp://host:8786)")
     w.add_argument("--out", required=True)
     w.add_argument("--force", action="store_true", help="replace an existing --out")
+    for name, what in (("touchweight", "the static touchweight (gf)"),
+                       ("regulate", "regulate the action into the literature's bands"),
+                       ("validate", "the validation experiments against the literature")):
+        c = sub.add_parser(name, help=what)
+        c.add_argument("--model", default="double")
+        c.add_argument("--params")
+    d = sub.add_parser("diagnose", help="diagnose datasets (swing test or key drive)")
+    d.add_argument("datasets", nargs="+")
+    d.add_argument("--out", required=True, help="reports go to OUT/<dataset folder name>")
+    d.add_argument("--library", help="the effects to try (comma-separated ids)")
+    d.add_argument("--params")
+    d.add_argument("--scheduler", help="a Dask scheduler's address (tcp://host:8786)")
+    d.add_argument("--force", action="store_true", help="replace earlier reports")
     a = parser.parse_args(argv)
+    commands = {"simulate": _simulate, "sweep": _sweep, "touchweight": _analysis,
+                "regulate": _analysis, "validate": _analysis, "diagnose": _diagnose}
     try:
-        return _simulate(a) if a.command == "simulate" else _sweep(a)
+        return commands[a.command](a)
     except PianoError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -122,3 +122,28 @@ def sweep_row(
 ) -> str: ...
 def sweep_failed_row(touch: str, value: float, reason: str) -> str: ...
 def format_number(value: float) -> str: ...
+def touchweight(params: Optional[Params] = None, model: str = "double") -> Dict[str, float]: ...
+def regulate(params: Optional[Params] = None, model: str = "double") -> Dict[str, Any]: ...
+def validate(params: Optional[Params] = None, model: str = "double") -> Dict[str, Any]: ...
+def synth(
+    out: Union[str, PathLike[str]],
+    truth: Union[str, PathLike[str]],
+    experiment: str = "pendulum",
+    effect: Optional[str] = None,
+    seed: int = 0,
+    releases_deg: Optional[List[float]] = None,
+    heights_mm: Optional[List[float]] = None,
+    markers: Optional[List[str]] = None,
+    mass_kg: float = 1.0,
+    duration_s: Optional[float] = None,
+    params: Optional[Params] = None,
+    force: bool = False,
+) -> Dict[str, Any]: ...
+def diagnose_to_disk(
+    dataset: Union[str, PathLike[str]],
+    out: Union[str, PathLike[str]],
+    params: Optional[Params] = None,
+    library: Optional[str] = None,
+    write_params: Optional[Union[str, PathLike[str]]] = None,
+    force: bool = False,
+) -> List[str]: ...
