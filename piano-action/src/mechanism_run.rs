@@ -49,6 +49,40 @@ pub struct MechanismRun {
     pub metrics: Vec<MetricValue>,
 }
 
+/// The summary of a mechanism run, as its `summary.json` has it (the mechanism's name, its
+/// metrics, its named events and how many contact events), with `all_events` added: what
+/// `events.json` holds (the named events and every contact onset and release, in time
+/// order).
+pub fn mechanism_summary(run: &MechanismRun) -> Value {
+    let mut events: Vec<Value> = run
+        .events
+        .iter()
+        .map(|e| json!({"name": e.name, "time_s": e.time_s, "named": true}))
+        .collect();
+    for (c, onset, t) in &run.contact_events {
+        let what = if *onset { "onset" } else { "release" };
+        events.push(json!({"name": format!("{c} {what}"), "time_s": t, "named": false}));
+    }
+    events.sort_by(|a, b| {
+        a["time_s"]
+            .as_f64()
+            .unwrap_or(0.0)
+            .total_cmp(&b["time_s"].as_f64().unwrap_or(0.0))
+    });
+    let metrics: Vec<Value> = run
+        .metrics
+        .iter()
+        .map(|v| json!({"name": v.name, "value": v.value, "unit": v.unit}))
+        .collect();
+    json!({
+        "mechanism": run.mechanism.name,
+        "metrics": metrics,
+        "events": run.events.iter().map(|e| json!({"name": e.name, "time_s": e.time_s})).collect::<Vec<_>>(),
+        "contact_events": run.contact_events.len(),
+        "all_events": events,
+    })
+}
+
 /// The coordinates of `mechanism` settled at rest for `settle_s` from its layout (the
 /// layout itself for 0). The last few results are remembered (a sweep settles the same
 /// mechanism once).
@@ -358,38 +392,13 @@ pub fn write_mechanism_run_dir(
     }
     write(dir, "series.csv", &csv)?;
 
-    // Events: the named ones, then every contact onset and release.
-    let mut events: Vec<Value> = run
-        .events
-        .iter()
-        .map(|e| json!({"name": e.name, "time_s": e.time_s, "named": true}))
-        .collect();
-    for (c, onset, t) in &run.contact_events {
-        let what = if *onset { "onset" } else { "release" };
-        events.push(json!({"name": format!("{c} {what}"), "time_s": t, "named": false}));
+    let summary = mechanism_summary(run);
+    write_json(dir, "events.json", &summary["all_events"])?;
+    let mut summary = summary;
+    if let Some(map) = summary.as_object_mut() {
+        map.remove("all_events");
     }
-    events.sort_by(|a, b| {
-        a["time_s"]
-            .as_f64()
-            .unwrap_or(0.0)
-            .total_cmp(&b["time_s"].as_f64().unwrap_or(0.0))
-    });
-    write_json(dir, "events.json", &Value::from(events.clone()))?;
-    let metrics: Vec<Value> = run
-        .metrics
-        .iter()
-        .map(|v| json!({"name": v.name, "value": v.value, "unit": v.unit}))
-        .collect();
-    write_json(
-        dir,
-        "summary.json",
-        &json!({
-            "mechanism": m.name,
-            "metrics": metrics,
-            "events": run.events.iter().map(|e| json!({"name": e.name, "time_s": e.time_s})).collect::<Vec<_>>(),
-            "contact_events": run.contact_events.len(),
-        }),
-    )?;
+    write_json(dir, "summary.json", &summary)?;
 
     // Drawings: at rest and at the first occurrence of each named event.
     let svg = crate::drawing::mechanism_svg(

@@ -521,32 +521,41 @@ impl Scenario {
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| PianoError::io(path, "read the scenario", e))?;
-        let mut scenario = Self::from_toml_str(&text).map_err(|e| e.in_file(path))?;
-        if let Some(file) = &scenario.mechanism {
-            let full = path.parent().unwrap_or(Path::new(".")).join(file);
+        Self::from_toml_str_in(&text, path.parent().unwrap_or(Path::new(".")), Some(path))
+    }
+
+    /// Parses a scenario as [`Scenario::load`] does a file's text: the files it names (a
+    /// mechanism description, a motion's `csv`) are read relative to the folder `base`;
+    /// errors name `file` when given.
+    pub fn from_toml_str_in(text: &str, base: &Path, file: Option<&Path>) -> Result<Self> {
+        let named = |e: PianoError| match file {
+            Some(path) => e.in_file(path),
+            None => e,
+        };
+        let mut scenario = Self::from_toml_str(text).map_err(named)?;
+        if let Some(name) = &scenario.mechanism {
+            let full = base.join(name);
             if !full.is_file() {
-                return Err(PianoError::scenario(
+                return Err(named(PianoError::scenario(
                     "mechanism",
                     format!("cannot read the mechanism description {}", full.display()),
-                )
-                .in_file(path)
-                .locate_in_toml(&text));
+                ))
+                .locate_in_toml(text));
             }
             scenario.loaded_mechanism = Some(mbs_mechanism::Mechanism::load(&full)?);
         }
         if let InputSpec::Motion(MotionSpec {
             points,
-            csv: Some(file),
+            csv: Some(name),
         }) = &mut scenario.input
         {
-            let full = path.parent().unwrap_or(Path::new(".")).join(&*file);
+            let full = base.join(&*name);
             let csv_text = std::fs::read_to_string(&full).map_err(|e| {
-                PianoError::scenario(
+                named(PianoError::scenario(
                     "input.csv",
                     format!("cannot read the key motion {}: {e}", full.display()),
-                )
-                .in_file(path)
-                .locate_in_toml(&text)
+                ))
+                .locate_in_toml(text)
             })?;
             let (rows, lines) = read_points_csv_lines(&csv_text, &full)?;
             *points = Some(rows);
@@ -566,7 +575,7 @@ impl Scenario {
                         bad.field = String::new();
                         PianoError::Input(bad)
                     }
-                    (_, e) => e.in_file(path),
+                    (_, e) => named(e),
                 }
             })?;
         }
@@ -896,6 +905,53 @@ pub fn run_summary(run: &Run) -> serde_json::Value {
     })
 }
 
+/// The summary of a swing test, as its `summary.json` has it: the turning points, the
+/// period measured and the small-amplitude one, the centre of mass's distance from the pin
+/// and the inertia about it (`events` lists the turns).
+pub fn pendulum_summary(
+    params: &ActionParams,
+    swing: &crate::pendulum::Swing,
+) -> serde_json::Value {
+    let events: Vec<serde_json::Value> = swing
+        .turns
+        .iter()
+        .map(|t| serde_json::json!({"name": "turn", "time_s": t.time_s}))
+        .collect();
+    let turns: Vec<serde_json::Value> = swing
+        .turns
+        .iter()
+        .map(|t| serde_json::json!({"time_s": t.time_s, "angle_deg": t.angle_rad.to_degrees()}))
+        .collect();
+    // Two turns per period.
+    let period = (swing.turns.len() >= 2).then(|| {
+        let (first, last) = (
+            swing.turns[0].time_s,
+            swing.turns[swing.turns.len() - 1].time_s,
+        );
+        2.0 * (last - first) / (swing.turns.len() - 1) as f64
+    });
+    let m = params.hammer.mass_g * 1e-3;
+    let small = 2.0
+        * std::f64::consts::PI
+        * (swing.inertia_pin_kg_m2 / (m * crate::params::GRAVITY_M_S2 * swing.com_distance_m))
+            .sqrt();
+    serde_json::json!({
+        "model": "pendulum",
+        "strikes": [],
+        "let_off_time_s": null,
+        "key_bottom_time_s": null,
+        "check_time_s": null,
+        "events": events,
+        "pendulum": {
+            "turns": turns,
+            "period_s": num(period),
+            "small_amplitude_period_s": small,
+            "com_distance_m": swing.com_distance_m,
+            "inertia_pin_kg_m2": swing.inertia_pin_kg_m2,
+        },
+    })
+}
+
 /// Writes `trajectory.csv` (time, then `<name>_q` and `<name>_v` for every coordinate in
 /// `names`, then the `extra` column if given) and, when the state holds more than the
 /// coordinates and velocities (`state_len`), [`INTERNAL_STATES_CSV`] with the force
@@ -1059,45 +1115,8 @@ pub fn write_pendulum_dir(
             write_file(dir, &format!("drawing_{file}.svg"), &svg)?;
         }
     }
-    let events: Vec<serde_json::Value> = swing
-        .turns
-        .iter()
-        .map(|t| serde_json::json!({"name": "turn", "time_s": t.time_s}))
-        .collect();
-    write_json(dir, "events.json", &serde_json::Value::from(events.clone()))?;
-    let turns: Vec<serde_json::Value> = swing
-        .turns
-        .iter()
-        .map(|t| serde_json::json!({"time_s": t.time_s, "angle_deg": t.angle_rad.to_degrees()}))
-        .collect();
-    // Two turns per period.
-    let period = (swing.turns.len() >= 2).then(|| {
-        let (first, last) = (
-            swing.turns[0].time_s,
-            swing.turns[swing.turns.len() - 1].time_s,
-        );
-        2.0 * (last - first) / (swing.turns.len() - 1) as f64
-    });
-    let m = params.hammer.mass_g * 1e-3;
-    let small = 2.0
-        * std::f64::consts::PI
-        * (swing.inertia_pin_kg_m2 / (m * crate::params::GRAVITY_M_S2 * swing.com_distance_m))
-            .sqrt();
-    let summary = serde_json::json!({
-        "model": "pendulum",
-        "strikes": [],
-        "let_off_time_s": null,
-        "key_bottom_time_s": null,
-        "check_time_s": null,
-        "events": events,
-        "pendulum": {
-            "turns": turns,
-            "period_s": num(period),
-            "small_amplitude_period_s": small,
-            "com_distance_m": swing.com_distance_m,
-            "inertia_pin_kg_m2": swing.inertia_pin_kg_m2,
-        },
-    });
+    let summary = pendulum_summary(params, swing);
+    write_json(dir, "events.json", &summary["events"])?;
     write_json(dir, "summary.json", &summary)?;
     Ok(())
 }

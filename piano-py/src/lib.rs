@@ -48,6 +48,14 @@ fn to_py(e: PianoError) -> PyErr {
                 Some(path.clone()),
                 text.clone(),
             ),
+            PianoError::Mechanism(m) => (
+                InputError::new_err(text.clone()),
+                Some("mechanism description".to_string()),
+                m.file.clone(),
+                m.line,
+                Some(m.field.clone()).filter(|f| !f.is_empty()),
+                m.message.clone(),
+            ),
             PianoError::File { path, message } => (
                 PianoFileError::new_err(text.clone()),
                 None,
@@ -550,15 +558,232 @@ impl RunPy {
         from: usize,
         to: usize,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let sol = &self.run.solution;
-        let mut data = Vec::with_capacity(sol.len() * (to - from));
-        for i in 0..sol.len() {
-            data.extend_from_slice(&sol.state(i)[from..to]);
-        }
-        let a = Array2::from_shape_vec((sol.len(), to - from), data)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        Ok(a.into_pyarray(py))
+        state_columns(py, &self.run.solution, from, to)
     }
+}
+
+/// A mechanism description (TOML or JSON): bodies, joints, contacts, inputs, events and
+/// metrics (see `examples/mechanisms/`).
+#[pyclass(module = "piano_action._core", name = "Mechanism", from_py_object)]
+#[derive(Clone)]
+struct MechanismPy {
+    inner: piano_action::mechanism::Mechanism,
+}
+
+#[pymethods]
+impl MechanismPy {
+    /// Reads and checks a description; errors name the file, the line and the field.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let inner = piano_action::mechanism::Mechanism::load(&path)
+            .map_err(|e| to_py(PianoError::from(e)))?;
+        inner.validate().map_err(|e| to_py(PianoError::from(e)))?;
+        Ok(MechanismPy { inner })
+    }
+
+    /// Its name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+
+    /// Its bodies' names.
+    #[getter]
+    fn bodies(&self) -> Vec<String> {
+        self.inner.bodies.iter().map(|b| b.name.clone()).collect()
+    }
+
+    /// Its contacts' names.
+    #[getter]
+    fn contacts(&self) -> Vec<String> {
+        self.inner.contacts.iter().map(|c| c.name.clone()).collect()
+    }
+
+    /// The whole description as a dict (its JSON form).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let v =
+            serde_json::to_value(&self.inner).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        json_to_py(py, &v)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Mechanism({:?})", self.inner.name)
+    }
+}
+
+/// The result of a scenario running a mechanism description.
+#[pyclass(module = "piano_action._core", name = "MechanismRun")]
+struct MechanismRunPy {
+    run: piano_action::mechanism_run::MechanismRun,
+}
+
+#[pymethods]
+impl MechanismRunPy {
+    /// The description's name.
+    #[getter]
+    fn mechanism(&self) -> String {
+        self.run.mechanism.name.clone()
+    }
+
+    /// Output times (s), shape `(n,)`.
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.run.solution.t.clone())
+    }
+
+    /// The coordinates' names (the columns of `q` and `v`).
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.run.built.system.model().coordinate_names().to_vec()
+    }
+
+    /// Coordinates, shape `(n, coordinates)`.
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let nv = self.run.built.system.model().coordinate_names().len();
+        state_columns(py, &self.run.solution, 0, nv)
+    }
+
+    /// Velocities, shape `(n, coordinates)`.
+    #[getter]
+    fn v<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let nv = self.run.built.system.model().coordinate_names().len();
+        state_columns(py, &self.run.solution, nv, 2 * nv)
+    }
+
+    /// The whole state, shape `(n, states)`.
+    #[getter]
+    fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        state_columns(py, &self.run.solution, 0, self.run.solution.n)
+    }
+
+    /// The description's named events, in time order.
+    #[getter]
+    fn events(&self) -> Vec<Event> {
+        self.run
+            .events
+            .iter()
+            .map(|e| Event {
+                name: e.name.clone(),
+                time_s: e.time_s,
+            })
+            .collect()
+    }
+
+    /// Contact onsets and releases: `(contact, onset, time_s)`.
+    #[getter]
+    fn contact_events(&self) -> Vec<(String, bool, f64)> {
+        self.run.contact_events.clone()
+    }
+
+    /// The description's metrics: name to value (None when its event never happened).
+    #[getter]
+    fn metrics(&self) -> Vec<(String, Option<f64>, String)> {
+        self.run
+            .metrics
+            .iter()
+            .map(|m| (m.name.clone(), m.value, m.unit.clone()))
+            .collect()
+    }
+
+    /// The summary, as `summary.json` of `piano simulate` has it (a dict).
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let mut v = piano_action::mechanism_run::mechanism_summary(&self.run);
+        if let Some(map) = v.as_object_mut() {
+            map.remove("all_events");
+        }
+        json_to_py(py, &v)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "MechanismRun({:?}, points={})",
+            self.run.mechanism.name,
+            self.run.solution.len()
+        )
+    }
+}
+
+/// The hammer swing test: the hammer alone on its flange, released from an angle.
+#[pyclass(module = "piano_action._core", name = "Swing")]
+struct SwingPy {
+    swing: piano_action::pendulum::Swing,
+    params: ActionParams,
+}
+
+#[pymethods]
+impl SwingPy {
+    /// Output times (s).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.swing.t.clone())
+    }
+
+    /// Angle from the hanging position (rad).
+    #[getter]
+    fn angle_rad<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.swing.angle_rad.clone())
+    }
+
+    /// Angular rate (rad/s).
+    #[getter]
+    fn rate_rad_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.swing.rate_rad_s.clone())
+    }
+
+    /// Turning points: `(time_s, angle_rad)`.
+    #[getter]
+    fn turns(&self) -> Vec<(f64, f64)> {
+        self.swing
+            .turns
+            .iter()
+            .map(|t| (t.time_s, t.angle_rad))
+            .collect()
+    }
+
+    /// Centre of mass to the centre pin (m).
+    #[getter]
+    fn com_distance_m(&self) -> f64 {
+        self.swing.com_distance_m
+    }
+
+    /// Inertia about the centre pin (kg m²).
+    #[getter]
+    fn inertia_pin_kg_m2(&self) -> f64 {
+        self.swing.inertia_pin_kg_m2
+    }
+
+    /// The summary, as `summary.json` of `piano simulate` has it (a dict).
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_to_py(
+            py,
+            &piano_action::scenario::pendulum_summary(&self.params, &self.swing),
+        )
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Swing(points={}, turns={})",
+            self.swing.t.len(),
+            self.swing.turns.len()
+        )
+    }
+}
+
+/// Columns `from..to` of a solution's states as an `(n, to − from)` array.
+fn state_columns<'py>(
+    py: Python<'py>,
+    sol: &mbs_integrators::Solution,
+    from: usize,
+    to: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let mut data = Vec::with_capacity(sol.len() * (to - from));
+    for i in 0..sol.len() {
+        data.extend_from_slice(&sol.state(i)[from..to]);
+    }
+    let a = Array2::from_shape_vec((sol.len(), to - from), data)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py))
 }
 
 /// A JSON value as Python objects (dicts, lists, floats, ints, str, None).
@@ -591,52 +816,63 @@ fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py
     })
 }
 
-/// Runs a scenario on a grand model; a scenario with a mechanism description or the
-/// swing test is refused with a message saying so (the command line runs them).
-fn run_scenario(py: Python<'_>, scenario: ScenarioPy, params: ActionParams) -> PyResult<RunPy> {
+/// Runs a scenario: a keystroke on a grand model (a `Run`), a mechanism description (a
+/// `MechanismRun`) or the hammer swing test (a `Swing`), with the GIL released.
+fn run_scenario(py: Python<'_>, scenario: ScenarioPy, params: ActionParams) -> PyResult<Py<PyAny>> {
     let s = &scenario.inner;
-    if s.mechanism.is_some() {
-        return Err(to_py(PianoError::scenario(
-            "mechanism",
-            "a scenario with a mechanism description is run by `piano simulate`; from \
-             Python, only the grand models (simplified, single, double) so far",
-        )));
+    let in_file = |e: PianoError| match &scenario.file {
+        Some(f) => e.in_file(f),
+        None => e,
+    };
+    if s.loaded_mechanism.is_some() {
+        let run = py
+            .detach(|| s.run_mechanism(&params, &mut |_| {}))
+            .map_err(|e| to_py(in_file(e)))?;
+        return Ok(Py::new(py, MechanismRunPy { run })?.into_any());
     }
-    if let InputSpec::Pendulum(_) = s.input {
-        return Err(to_py(PianoError::scenario(
-            "input.kind",
-            "the hammer swing test is run by `piano simulate`; from Python, keystrokes \
-             only so far",
-        )));
+    if let InputSpec::Pendulum(spec) = &s.input {
+        let swing = py
+            .detach(|| {
+                piano_action::pendulum::swing_sampled(
+                    &params,
+                    spec.release_angle_deg,
+                    s.duration_s,
+                    s.output_step_s,
+                )
+            })
+            .map_err(|e| to_py(in_file(e)))?;
+        return Ok(Py::new(py, SwingPy { swing, params })?.into_any());
     }
     let kind = s.model_kind().map_err(to_py)?;
     let input = s.input.to_input().map_err(to_py)?;
     let names = piano_action::simulate::coordinate_names(&params, kind, &input).map_err(to_py)?;
-    let run = py.detach(|| s.run(&params)).map_err(|e| {
-        to_py(match &scenario.file {
-            // Scenario::run's errors are the simulation's, or a value of the file.
-            Some(f) => e.in_file(f),
-            None => e,
-        })
-    })?;
-    Ok(RunPy {
-        run,
-        params,
-        scenario: scenario.inner,
-        names,
-    })
+    let run = py
+        .detach(|| s.run(&params))
+        .map_err(|e| to_py(in_file(e)))?;
+    Ok(Py::new(
+        py,
+        RunPy {
+            run,
+            params,
+            scenario: scenario.inner,
+            names,
+        },
+    )?
+    .into_any())
 }
 
 /// Simulates `scenario` (a `Scenario`, a path to a scenario file, or a dict in the
 /// scenario file's shape) with `params` (the reference by default), as `piano simulate`
-/// does: the same numbers to the bit. The GIL is released while it runs.
+/// does: the same numbers to the bit. Returns a `Run` for a keystroke on a grand model, a
+/// `MechanismRun` for a scenario with a mechanism description and a `Swing` for the
+/// hammer swing test. The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (scenario, params=None))]
 fn simulate(
     py: Python<'_>,
     scenario: &Bound<'_, PyAny>,
     params: Option<Params>,
-) -> PyResult<RunPy> {
+) -> PyResult<Py<PyAny>> {
     let scenario = scenario_from(py, scenario)?;
     run_scenario(py, scenario, params_or_reference(params.as_ref()))
 }
@@ -658,16 +894,19 @@ fn scenario_from(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<ScenarioPy>
                 format!("cannot be written as a scenario: {e}"),
             ))
         })?;
-        let inner = Scenario::from_toml_str(&toml_text).map_err(|e| {
-            to_py(match e {
-                // Lines of the TOML made from the dict mean nothing to the caller.
-                PianoError::Input(mut i) => {
-                    i.line = None;
-                    PianoError::Input(i)
-                }
-                other => other,
-            })
-        })?;
+        // Files it names (a mechanism description, a motion's CSV) are read relative to the
+        // working folder.
+        let inner = Scenario::from_toml_str_in(&toml_text, std::path::Path::new("."), None)
+            .map_err(|e| {
+                to_py(match e {
+                    // Lines of the TOML made from the dict mean nothing to the caller.
+                    PianoError::Input(mut i) => {
+                        i.line = None;
+                        PianoError::Input(i)
+                    }
+                    other => other,
+                })
+            })?;
         return Ok(ScenarioPy { inner, file: None });
     }
     if let Ok(path) = obj.extract::<PathBuf>() {
@@ -963,6 +1202,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RunPy>()?;
     m.add_class::<Event>()?;
     m.add_class::<Strike>()?;
+    m.add_class::<MechanismPy>()?;
+    m.add_class::<MechanismRunPy>()?;
+    m.add_class::<SwingPy>()?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_levels, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_row, m)?)?;

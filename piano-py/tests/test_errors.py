@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 import piano_action as pa
-from conftest import SCENARIOS
+from conftest import ROOT, SCENARIOS
 
 
 def test_a_wrong_scenario_file_names_file_line_and_field(tmp_path, piano):
@@ -81,7 +81,12 @@ def test_absurd_durations_and_levels():
         pa.sweep({"touch": "pressed", "values": [1.0, -3.0]})
 
 
-def test_not_yet_from_python_says_so():
+def test_a_wrong_mechanism_description_names_its_file_and_field(tmp_path):
+    text = (ROOT / "examples" / "mechanisms" / "glockenspiel.toml").read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("\nmass = ", "\nmass = -", 1))
     with pytest.raises(pa.InputError) as info:
-        pa.simulate(SCENARIOS / "pendulum.toml")
-    assert "piano simulate" in str(info.value)
+        pa.Mechanism.load(bad)
+    e = info.value
+    assert e.kind == "mechanism description" and e.file == str(bad)
+    assert e.line == 34 and e.field.endswith("mass")

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import piano_action as pa
-from conftest import SCENARIOS
+from conftest import ROOT, SCENARIOS
 
 
 def read_csv(path):
@@ -143,3 +143,46 @@ def test_the_gil_is_released_while_simulating():
     finally:
         sys.setswitchinterval(interval)
     assert seen_inside > 0
+
+
+def test_the_swing_test_equals_the_command_line(piano, tmp_path):
+    path = SCENARIOS / "pendulum.toml"
+    out = tmp_path / "run"
+    piano("simulate", path, "--out", out)
+    swing = pa.simulate(path)
+    assert isinstance(swing, pa.Swing)
+    header, traj = read_csv(out / "trajectory.csv")
+    assert header == ["time_s", "hammer_q", "hammer_v"]
+    assert np.array_equal(swing.t, traj[:, 0])
+    assert np.array_equal(swing.angle_rad, traj[:, 1])
+    assert np.array_equal(swing.rate_rad_s, traj[:, 2])
+    assert swing.summary() == json.loads((out / "summary.json").read_text())
+    # Coulomb friction at the flange: the amplitude falls by the same step every half swing.
+    amplitudes = [abs(a) for _, a in swing.turns]
+    steps = np.diff(amplitudes)
+    assert len(amplitudes) >= 3 and np.all(steps < 0)
+    assert np.ptp(steps) < 0.05 * abs(steps.mean())
+
+
+def test_a_mechanism_scenario_equals_the_command_line(piano, tmp_path):
+    mechanism = ROOT / "examples" / "mechanisms" / "upright.toml"
+    m = pa.Mechanism.load(mechanism)
+    assert m.name and "hammer" in " ".join(m.bodies)
+    scenario = tmp_path / "upright.toml"
+    scenario.write_text(f'mechanism = "{mechanism}"\nduration_s = 0.1\n\n'
+                        '[input]\nkind = "force"\nforce_n = 10.0\n')
+    out = tmp_path / "run"
+    piano("simulate", scenario, "--out", out)
+    run = pa.simulate(scenario)
+    assert isinstance(run, pa.MechanismRun)
+    header, traj = read_csv(out / "trajectory.csv")
+    n = len(run.coordinate_names)
+    assert header[1:1 + n] == [f"{c}_q" for c in run.coordinate_names]
+    assert np.array_equal(run.t, traj[:, 0])
+    assert np.array_equal(run.q, traj[:, 1:1 + n])
+    assert np.array_equal(run.v, traj[:, 1 + n:1 + 2 * n])
+    assert run.summary() == json.loads((out / "summary.json").read_text())
+    # The same as a dict, its description's path relative to the working folder.
+    as_dict = {"mechanism": str(mechanism), "duration_s": 0.1,
+               "input": {"kind": "force", "force_n": 10.0}}
+    assert np.array_equal(pa.simulate(as_dict).q, run.q)
