@@ -49,6 +49,47 @@ pub struct MechanismRun {
     pub metrics: Vec<MetricValue>,
 }
 
+/// Per contact (by name), its numbers at every output time, or None: see
+/// [`contact_series`].
+pub type ContactSeries = Vec<(String, Option<Vec<[f64; 6]>>)>;
+
+/// Every contact of a mechanism run on its output grid, as `contacts.csv` has them: per
+/// contact (by name), per sample, the gap (mm), the normal force (N, zero when not
+/// pressed), the contact point (mm) and the normal; None for a contact whose numbers the
+/// description's build does not give.
+pub fn contact_series(run: &MechanismRun) -> Result<ContactSeries> {
+    let system = &run.built.system;
+    let sol = &run.solution;
+    let mut ws = system.workspace();
+    let mut out = Vec::new();
+    for (name, &e) in &run.built.contacts {
+        let Some(c) = run.built.contact_handles.get(name) else {
+            out.push((name.clone(), None));
+            continue;
+        };
+        let mut rows = Vec::with_capacity(sol.len());
+        for i in 0..sol.len() {
+            let ctx = system.element_context(&mut ws, sol.t[i], sol.state(i), e)?;
+            let o = c.output(&ctx);
+            let f = if o.active {
+                o.normal_force.max(0.0)
+            } else {
+                0.0
+            };
+            rows.push([
+                o.gap * 1e3,
+                f,
+                o.point[0] * 1e3,
+                o.point[1] * 1e3,
+                o.normal[0],
+                o.normal[1],
+            ]);
+        }
+        out.push((name.clone(), Some(rows)));
+    }
+    Ok(out)
+}
+
 /// The summary of a mechanism run, as its `summary.json` has it (the mechanism's name, its
 /// metrics, its named events and how many contact events), with `all_events` added: what
 /// `events.json` holds (the named events and every contact onset and release, in time
@@ -290,30 +331,15 @@ pub fn write_mechanism_run_dir(
         );
     }
     csv.push('\n');
+    let series = contact_series(run)?;
     let mut ws = system.workspace();
     for i in 0..sol.len() {
-        let (t, x) = (sol.t[i], sol.state(i));
-        let _ = write!(csv, "{t}");
-        for (name, &e) in &run.built.contacts {
-            let ctx = system.element_context(&mut ws, t, x, e)?;
-            match run.built.contact_handles.get(name) {
-                Some(c) => {
-                    let o = c.output(&ctx);
-                    let f = if o.active {
-                        o.normal_force.max(0.0)
-                    } else {
-                        0.0
-                    };
-                    let _ = write!(
-                        csv,
-                        ",{},{},{},{},{},{}",
-                        o.gap * 1e3,
-                        f,
-                        o.point[0] * 1e3,
-                        o.point[1] * 1e3,
-                        o.normal[0],
-                        o.normal[1]
-                    );
+        let _ = write!(csv, "{}", sol.t[i]);
+        for (_, rows) in &series {
+            match rows {
+                Some(rows) => {
+                    let [gap, force, px, py, nx, ny] = rows[i];
+                    let _ = write!(csv, ",{gap},{force},{px},{py},{nx},{ny}");
                 }
                 None => csv.push_str(",,,,,,"),
             }

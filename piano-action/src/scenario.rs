@@ -1005,6 +1005,19 @@ pub fn write_trajectory(
     Ok(())
 }
 
+/// A contact's numbers as `contacts.csv` of a grand run has them, in its column order: the
+/// gap (mm), the normal force (N), the contact point (mm) and the normal.
+pub fn contact_columns(o: &mbs_contact::ContactOutput) -> [f64; 6] {
+    [
+        o.gap * 1e3,
+        o.normal_force,
+        o.point[0] * 1e3,
+        o.point[1] * 1e3,
+        o.normal[0],
+        o.normal[1],
+    ]
+}
+
 /// Writes `contacts.csv` (every contact's gap and normal force on the output grid) and the
 /// drawings of the action at rest, at let-off, at string contact and at the check (those
 /// that happen), with the pressed contacts marked.
@@ -1025,15 +1038,10 @@ fn write_contacts_and_drawings(dir: &Path, prepared: &Prepared, run: &Run) -> Re
         let _ = write!(csv, "{t}");
         for n in &names {
             let o = action.contact_output(n, t, x)?;
+            let [gap, force, px, py, nx, ny] = contact_columns(&o);
             let _ = write!(
                 csv,
-                ",{},{},{},{},{},{},{}",
-                o.gap * 1e3,
-                o.normal_force,
-                o.point[0] * 1e3,
-                o.point[1] * 1e3,
-                o.normal[0],
-                o.normal[1],
+                ",{gap},{force},{px},{py},{nx},{ny},{}",
                 u8::from(o.active)
             );
         }

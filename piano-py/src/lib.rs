@@ -509,14 +509,7 @@ impl RunPy {
                     let mut active = Vec::with_capacity(sol.len());
                     for i in 0..sol.len() {
                         let o = action.contact_output(name, sol.t[i], sol.state(i))?;
-                        let vals = [
-                            o.gap * 1e3,
-                            o.normal_force,
-                            o.point[0] * 1e3,
-                            o.point[1] * 1e3,
-                            o.normal[0],
-                            o.normal[1],
-                        ];
+                        let vals = piano_action::scenario::contact_columns(&o);
                         for (c, v) in cols.iter_mut().zip(vals) {
                             c.push(v);
                         }
@@ -684,6 +677,31 @@ impl MechanismRunPy {
             .iter()
             .map(|m| (m.name.clone(), m.value, m.unit.clone()))
             .collect()
+    }
+
+    /// Every contact on the output grid, as `contacts.csv` of `piano simulate` has it: a
+    /// dict from the contact's name to a dict of arrays `gap_mm`, `force_n` (zero when not
+    /// pressed), `px_mm`, `py_mm`, `nx` and `ny` (None for a contact without numbers).
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let run = &self.run;
+        let series = py
+            .detach(|| piano_action::mechanism_run::contact_series(run))
+            .map_err(to_py)?;
+        let d = PyDict::new(py);
+        for (name, rows) in series {
+            let Some(rows) = rows else {
+                d.set_item(name, py.None())?;
+                continue;
+            };
+            let c = PyDict::new(py);
+            let keys = ["gap_mm", "force_n", "px_mm", "py_mm", "nx", "ny"];
+            for (k, key) in keys.into_iter().enumerate() {
+                let col: Vec<f64> = rows.iter().map(|r| r[k]).collect();
+                c.set_item(key, PyArray1::from_vec(py, col))?;
+            }
+            d.set_item(name, c)?;
+        }
+        Ok(d)
     }
 
     /// The summary, as `summary.json` of `piano simulate` has it (a dict).

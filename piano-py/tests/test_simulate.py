@@ -182,6 +182,14 @@ def test_a_mechanism_scenario_equals_the_command_line(piano, tmp_path):
     assert np.array_equal(run.q, traj[:, 1:1 + n])
     assert np.array_equal(run.v, traj[:, 1 + n:1 + 2 * n])
     assert run.summary() == json.loads((out / "summary.json").read_text())
+    header, table = read_csv(out / "contacts.csv")
+    contacts = run.contacts()
+    assert len(contacts) * 6 == len(header) - 1
+    for name, cols in contacts.items():
+        for key in ("gap_mm", "force_n", "px_mm", "py_mm", "nx", "ny"):
+            assert np.array_equal(cols[key], table[:, header.index(f"{name}_{key}")]), name
+    # The hammer reaches its string within the 0.1 s of a 10 N push.
+    assert max(cols["force_n"].max() for name, cols in contacts.items() if "string" in name) > 1
     # The same as a dict, its description's path relative to the working folder.
     as_dict = {"mechanism": str(mechanism), "duration_s": 0.1,
                "input": {"kind": "force", "force_n": 10.0}}
