@@ -1182,6 +1182,24 @@ fn synth(
             .collect::<Result<Vec<_>, _>>()
     };
     let key_drive = experiment == piano_action::identify::key_drive::EXPERIMENT;
+    // The experiment and the options that do not apply to it first, as they always were;
+    // then the numbers.
+    if !key_drive && experiment != "pendulum" {
+        return Err(format!(
+            "option --experiment: '{experiment}': 'pendulum' or 'key_drive'"
+        ));
+    }
+    if !key_drive && markers.is_some() {
+        return Err(
+            "option --markers: the key drive's; a pendulum dataset tracks the \
+                    hammer's head and shank"
+                .into(),
+        );
+    }
+    if let (true, Some(e)) = (key_drive, effect) {
+        piano_action::identify::action_effects::ActionEffect::parse(e)
+            .map_err(|e| e.to_string())?;
+    }
     let request = SynthRequest {
         experiment: experiment.to_string(),
         effect: effect.map(str::to_string),

@@ -228,6 +228,22 @@ impl Params {
     }
 }
 
+impl Params {
+    /// The text these parameters were read from, if they still say the same (a file's
+    /// comments and source tags are kept); else the values written afresh; None for the
+    /// unchanged reference.
+    fn source_text(&self) -> PyResult<Option<String>> {
+        let read = match &self.text {
+            Some(t) => ActionParams::from_toml_str(t).ok(),
+            None => Some(ActionParams::reference()),
+        };
+        if read.as_ref() == Some(&self.inner) {
+            return Ok(self.text.clone());
+        }
+        self.inner.to_toml_string().map(Some).map_err(to_py)
+    }
+}
+
 /// The parameters given, or the reference.
 fn params_or_reference(params: Option<&Params>) -> ActionParams {
     params.map_or_else(ActionParams::reference, |p| p.inner.clone())
@@ -493,7 +509,7 @@ impl RunPy {
 
     /// Every contact on the output grid, as `contacts.csv` of `piano simulate` has it: a
     /// dict from the contact's name to a dict of arrays `gap_mm`, `force_n`, `px_mm`,
-    /// `py_mm`, `nx`, `ny` and `active` (bool). Computed on the first call (it rebuilds the
+    /// `py_mm`, `nx`, `ny` and `active` (bool). Computed at each call (it rebuilds the
     /// action at rest, a few milliseconds), with the GIL released.
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let (params, scenario, run) = (&self.params, &self.scenario, &self.run);
@@ -891,22 +907,19 @@ fn simulate(
     scenario: &Bound<'_, PyAny>,
     params: Option<Params>,
 ) -> PyResult<Py<PyAny>> {
-    let scenario = scenario_from(py, scenario)?;
+    let scenario = scenario_from(scenario)?;
     run_scenario(py, scenario, params_or_reference(params.as_ref()))
 }
 
 /// A `Scenario` from what `simulate` accepts.
-fn scenario_from(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<ScenarioPy> {
+fn scenario_from(obj: &Bound<'_, PyAny>) -> PyResult<ScenarioPy> {
     if let Ok(s) = obj.extract::<ScenarioPy>() {
         return Ok(s);
     }
-    if obj.is_instance_of::<PyDict>() {
-        // Through JSON into TOML text, so the file's own checks (and field paths) apply.
-        let json = py.import("json")?.call_method1("dumps", (obj,))?;
-        let text: String = json.extract()?;
-        let value: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| to_py(PianoError::scenario("", format!("not a scenario: {e}"))))?;
-        let toml_text = toml::to_string(&value).map_err(|e| {
+    if let Ok(dict) = obj.cast::<PyDict>() {
+        // Into TOML text, so the file's own checks (and field paths) apply.
+        let table = py_to_toml(dict.as_any(), "")?;
+        let toml_text = toml::to_string(&table).map_err(|e| {
             to_py(PianoError::scenario(
                 "",
                 format!("cannot be written as a scenario: {e}"),
@@ -917,8 +930,9 @@ fn scenario_from(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<ScenarioPy>
         let inner = Scenario::from_toml_str_in(&toml_text, std::path::Path::new("."), None)
             .map_err(|e| {
                 to_py(match e {
-                    // Lines of the TOML made from the dict mean nothing to the caller.
-                    PianoError::Input(mut i) => {
+                    // Lines of the TOML made from the dict mean nothing to the caller; those
+                    // of a file it names (a motion's CSV) do.
+                    PianoError::Input(mut i) if i.file.is_none() => {
                         i.line = None;
                         PianoError::Input(i)
                     }
@@ -936,6 +950,64 @@ fn scenario_from(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<ScenarioPy>
             "expected a Scenario, a path to a scenario file or a dict, got {}",
             obj.get_type().name()?
         ),
+    )))
+}
+
+/// A Python value of a scenario dict as TOML (`path` names it in errors): dicts with string
+/// keys, lists and tuples, str, bool, int (or anything with `__index__`, such as numpy's
+/// integers), float (or anything with `__float__`, such as numpy's floats; NaN and inf are
+/// kept for the scenario's checks to name).
+fn py_to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyString, PyTuple};
+    let at = |key: &str| {
+        if path.is_empty() {
+            key.to_string()
+        } else {
+            format!("{path}.{key}")
+        }
+    };
+    let wrong = |message: String| to_py(PianoError::scenario(path, message));
+    if obj.is_none() {
+        return Err(wrong(
+            "is None: leave the field out for its default".to_string(),
+        ));
+    }
+    if let Ok(b) = obj.cast::<PyBool>() {
+        return Ok(toml::Value::Boolean(b.is_true()));
+    }
+    if let Ok(t) = obj.cast::<PyString>() {
+        return Ok(toml::Value::String(t.to_str()?.to_string()));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in d.iter() {
+            let key: String = k
+                .extract()
+                .map_err(|_| wrong(format!("has a key that is not a string: {k}")))?;
+            let value = py_to_toml(&v, &at(&key))?;
+            table.insert(key, value);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
+        let mut out = Vec::new();
+        for (i, v) in obj.try_iter()?.enumerate() {
+            out.push(py_to_toml(&v?, &format!("{path}[{i}]"))?);
+        }
+        return Ok(toml::Value::Array(out));
+    }
+    if obj.is_instance_of::<PyInt>() || obj.hasattr("__index__")? {
+        let i: i64 = obj
+            .extract()
+            .map_err(|_| wrong(format!("{obj} is out of range")))?;
+        return Ok(toml::Value::Integer(i));
+    }
+    if obj.is_instance_of::<PyFloat>() || obj.hasattr("__float__")? {
+        return Ok(toml::Value::Float(obj.extract()?));
+    }
+    Err(wrong(format!(
+        "a {} is not a scenario value (numbers, strings, booleans, lists and dicts are)",
+        obj.get_type().name()?
     )))
 }
 
@@ -992,6 +1064,14 @@ fn sweep_levels(
 #[pyfunction]
 fn check_sweep_levels(touch: &str, values: Vec<f64>) -> PyResult<()> {
     check_levels(sweep_kind(touch)?, &values).map_err(to_py)
+}
+
+/// Checks a sweep's model name and duration before any run (errors name `model` or
+/// `duration_s`).
+#[pyfunction]
+fn check_sweep(model: &str, duration_s: f64) -> PyResult<()> {
+    model_kind(model)?;
+    piano_action::simulate::check_duration(duration_s, 1e-3).map_err(to_py)
 }
 
 /// The header of a sweep's CSV (`piano sweep`'s).
@@ -1172,9 +1252,12 @@ fn synth<'py>(
 /// or the key drive, by its `experiment`), writing `report.json`, `report.md` and
 /// `report.html` into `out` (refused if it holds an earlier report, unless `force`) and, for
 /// a swing test, the corrected parameter file `write_params` if asked. `library` names the
-/// effects to try (comma-separated ids; all by default). Returns the paths written; the
-/// report itself is `report.json` (see `piano_action.diagnose`, which reads it). The GIL
-/// is released while it runs.
+/// effects to try (comma-separated ids; all by default). Returns the paths written and,
+/// when `write_params` was asked for but not written, why; the report itself is
+/// `report.json` (see `piano_action.diagnose`, which reads it). The corrected parameter
+/// file keeps the comments of the file `params` was read from, unless `params` was changed
+/// since (by `set`, or a regulation): then it is written from the values. The GIL is
+/// released while it runs.
 #[pyfunction]
 #[pyo3(signature = (dataset, out, params=None, library=None, write_params=None, force=false))]
 fn diagnose_to_disk(
@@ -1185,12 +1268,10 @@ fn diagnose_to_disk(
     library: Option<String>,
     write_params: Option<PathBuf>,
     force: bool,
-) -> PyResult<Vec<String>> {
-    let source = params
-        .as_ref()
-        .and_then(|p| p.text.clone())
-        .unwrap_or_else(|| piano_action::params::DEFAULT_PARAMS_TOML.to_string());
+) -> PyResult<(Vec<String>, Option<String>)> {
     let base = params_or_reference(params.as_ref());
+    let source = params.as_ref().map_or(Ok(None), |p| p.source_text())?;
+    let source = source.unwrap_or_else(|| piano_action::params::DEFAULT_PARAMS_TOML.to_string());
     let done = py
         .detach(|| {
             piano_action::identify::commands::diagnose_dataset_to_disk(
@@ -1205,16 +1286,25 @@ fn diagnose_to_disk(
             )
         })
         .map_err(to_py)?;
-    Ok(done
+    let refused = match &done {
+        piano_action::identify::commands::Diagnosed::Pendulum(o) => o.params_refused.clone(),
+        piano_action::identify::commands::Diagnosed::KeyDrive(..) => None,
+    };
+    let written = done
         .written()
         .iter()
         .map(|p| p.display().to_string())
-        .collect())
+        .collect();
+    Ok((written, refused))
 }
 
 /// The extension module.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add(
+        "PanicException",
+        m.py().get_type::<pyo3::panic::PanicException>(),
+    )?;
     m.add_class::<Params>()?;
     m.add_class::<ScenarioPy>()?;
     m.add_class::<RunPy>()?;
@@ -1228,6 +1318,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep_row, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_header, m)?)?;
     m.add_function(wrap_pyfunction!(check_sweep_levels, m)?)?;
+    m.add_function(wrap_pyfunction!(check_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_failed_row, m)?)?;
     m.add_function(wrap_pyfunction!(format_number, m)?)?;
     m.add_function(wrap_pyfunction!(touchweight, m)?)?;

@@ -4,7 +4,9 @@
 //! "./piano-py[test]"`, as `.ci/run` does into `target/pyenv`): `PIANO_PYTHON` names its
 //! interpreter, else `target/pyenv/bin/python` is used. Without one this test says
 //! `SKIPPED` with how to make one, and fails instead under `PIANO_PYTHON_TESTS=required` or
-//! `CI`. The package is tested as installed: after changing Rust code, install it again.
+//! `CI`. The package is tested as installed; when it is older than the Rust sources it is
+//! built from, this test says so (SKIPPED, or FAILED where required) rather than test old
+//! code: install it again.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -58,20 +60,20 @@ fn run() -> Outcome {
             Outcome::Skipped(why)
         };
     }
-    // The command line the tests compare with: the one `cargo test --workspace` built
-    // beside this test (`target/<profile>/piano`), else the tests build it.
-    let mut pytest = Command::new(&python);
-    pytest
+    if let Some(why) = stale(&python, &root) {
+        return if harness::required("PIANO_PYTHON_TESTS") {
+            Outcome::Failed(format!("{why}, and the Python tests are required here"))
+        } else {
+            Outcome::Skipped(why)
+        };
+    }
+    // The command line the tests compare with is built by the tests (`cargo build`, a no-op
+    // when `cargo test` has just built it).
+    let out = Command::new(&python)
         .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
         .arg(root.join("piano-py/tests"))
-        .current_dir(&root);
-    let beside = std::env::current_exe()
-        .ok()
-        .and_then(|exe| Some(exe.parent()?.parent()?.join("piano")));
-    if let Some(bin) = beside.filter(|b| b.is_file()) {
-        pytest.env("PIANO_BIN", bin);
-    }
-    let out = pytest.output();
+        .current_dir(&root)
+        .output();
     match out {
         Err(e) => Outcome::Failed(format!("cannot run pytest: {e}")),
         Ok(out) => {
@@ -92,4 +94,64 @@ fn run() -> Outcome {
             }
         }
     }
+}
+
+/// Why the installed package is older than the Rust code it is built from (None when it is
+/// not): its tests would test the old code.
+fn stale(python: &Path, root: &Path) -> Option<String> {
+    let out = Command::new(python)
+        .args(["-c", "import piano_action._core as c; print(c.__file__)"])
+        .output()
+        .ok()?;
+    let built = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+    let built_at = std::fs::metadata(&built).ok()?.modified().ok()?;
+    let newest = newest_source(root)?;
+    (newest.1 > built_at).then(|| {
+        format!(
+            "the installed piano_action ({}) is older than {}; install it again: \
+             {} -m pip install \"./piano-py[test]\"",
+            built.display(),
+            newest.0.display(),
+            python.display()
+        )
+    })
+}
+
+/// The most recently changed Rust source or manifest of the crates the package is built
+/// from.
+fn newest_source(root: &Path) -> Option<(PathBuf, std::time::SystemTime)> {
+    let mut newest: Option<(PathBuf, std::time::SystemTime)> = None;
+    let mut stack: Vec<PathBuf> = [
+        "piano-py/src",
+        "piano-py/Cargo.toml",
+        "piano-action/src",
+        "mbs-core/src",
+        "mbs-contact/src",
+        "mbs-integrators/src",
+        "mbs-identify/src",
+        "mbs-mechanism/src",
+    ]
+    .iter()
+    .map(|p| root.join(p))
+    .collect();
+    while let Some(path) = stack.pop() {
+        let Ok(meta) = std::fs::metadata(&path) else {
+            continue;
+        };
+        if meta.is_dir() {
+            if let Ok(entries) = std::fs::read_dir(&path) {
+                stack.extend(entries.flatten().map(|e| e.path()));
+            }
+            continue;
+        }
+        let source = path
+            .extension()
+            .is_some_and(|e| e == "rs" || e == "toml" || e == "csv");
+        if let (true, Ok(at)) = (source, meta.modified())
+            && newest.as_ref().is_none_or(|(_, t)| at > *t)
+        {
+            newest = Some((path, at));
+        }
+    }
+    newest
 }

@@ -84,9 +84,20 @@ def test_absurd_durations_and_levels():
 def test_a_wrong_mechanism_description_names_its_file_and_field(tmp_path):
     text = (ROOT / "examples" / "mechanisms" / "glockenspiel.toml").read_text()
     bad = tmp_path / "bad.toml"
-    bad.write_text(text.replace("\nmass = ", "\nmass = -", 1))
+    changed = text.replace("\nmass = ", "\nmass = -", 1)
+    bad.write_text(changed)
+    line = changed[:changed.index("\nmass = -") + 1].count("\n") + 1
     with pytest.raises(pa.InputError) as info:
         pa.Mechanism.load(bad)
     e = info.value
     assert e.kind == "mechanism description" and e.file == str(bad)
-    assert e.line == 34 and e.field.endswith("mass")
+    assert e.line == line and e.field.endswith("mass")
+
+
+def test_a_wrong_sweep_grid_raises_before_any_run():
+    for grid in ({"touch": "force", "values": [5.0], "model": "quad"},
+                 {"touch": "force", "values": [5.0], "duration_s": -1.0},
+                 {"touch": "force", "values": [5.0], "set": {"hammer.mass_g": 11.0}},
+                 {"touch": "force", "values": [5.0], "set": {"hammer.mass_gg": [11.0]}}):
+        with pytest.raises(pa.InputError):
+            pa.sweep(grid, progress=False)

@@ -89,9 +89,30 @@ def _failing_task(touch, value, duration_s, model, params):
     return pa.sweep_row(touch, value, duration_s, model, params)
 
 
-def test_a_failed_task_fails_its_own_row(client, monkeypatch):
-    # The task function travels by value, so the workers run this one.
+@pytest.fixture
+def by_value():
+    # This module's functions travel to the workers by value, so they run the ones here.
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    yield
+    cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
+
+
+def _lost_batch(items, task):
+    if any(item[1] == 2.0 for item in items):
+        raise OSError("worker lost")
+    return sweep_module._batch(items, task)
+
+
+def test_a_lost_task_fails_the_rows_it_held(client, monkeypatch, by_value):
+    monkeypatch.setattr(sweep_module, "_batch", _lost_batch)
+    table = pa.sweep({"touch": "force", "values": [1.5, 2.0, 3.0, 4.0], "duration_s": 0.05},
+                     client=client, progress=False, batch=2)
+    assert [i for i, _ in table.errors()] == [0, 1]
+    assert all(why == "OSError: worker lost" for _, why in table.errors())
+    assert table.records()[2]["error"] is None and table.records()[3]["error"] is None
+
+
+def test_a_failed_task_fails_its_own_row(client, monkeypatch, by_value):
     monkeypatch.setattr(sweep_module, "_task", _failing_task)
     for c, batch in ((None, None), (client, None), (client, 2), (client, 3)):
         table = pa.sweep({"touch": "force", "values": [1.5, 2.0, 3.0], "duration_s": 0.05},

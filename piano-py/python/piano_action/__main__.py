@@ -22,8 +22,8 @@ import sys
 from pathlib import Path
 from typing import List, Optional
 
-from . import (Params, PianoError, diagnose_many, regulate, simulate, sweep, touchweight,
-               validate)
+from . import (MechanismRun, Params, PianoError, Swing, diagnose_many, regulate, simulate, sweep,
+               touchweight, validate)
 
 
 def _params(path: Optional[str]) -> Optional[Params]:
@@ -34,6 +34,14 @@ def _simulate(a: argparse.Namespace) -> int:
     run = simulate(a.scenario, _params(a.params))
     if a.json:
         print(json.dumps(run.summary(), indent=2))
+        return 0
+    if isinstance(run, Swing):
+        print(f"hammer swing: {len(run.turns)} turning points in {run.t[-1]:g} s")
+        return 0
+    if isinstance(run, MechanismRun):
+        print(f"{run.mechanism}: {len(run.t)} output points")
+        for name, value, unit in run.metrics:
+            print(f"  {name}: {'-' if value is None else f'{value:.4g} {unit}'}")
         return 0
     print(f"{run.model} action, {len(run.t)} output points")
     for s in run.strikes:
@@ -51,6 +59,8 @@ def _sweep(a: argparse.Namespace) -> int:
     out = Path(a.out)
     if out.exists() and not a.force:
         raise PianoError(f"{out}: exists; choose another --out, or pass --force to replace it")
+    if not out.parent.is_dir():
+        raise PianoError(f"{out}: its folder {out.parent} does not exist")
     grid = {"touch": a.touch, "runs": a.runs, "linear": a.linear, "duration_s": a.duration,
             "model": a.model}
     if a.start is not None:
@@ -59,7 +69,12 @@ def _sweep(a: argparse.Namespace) -> int:
         grid["stop"] = a.stop
     if a.params:
         grid["params"] = Params.load(a.params)
-    table = sweep(grid, client=_client(a.scheduler))
+    client = _client(a.scheduler)
+    try:
+        table = sweep(grid, client=client)
+    finally:
+        if client is not None:
+            client.close()
     out.write_text(table.to_csv())
     print(f"{len(table)} runs, {len(table.errors())} failed; table: {out}")
     return 0
@@ -82,8 +97,13 @@ def _analysis(a: argparse.Namespace) -> int:
 
 
 def _diagnose(a: argparse.Namespace) -> int:
-    table = diagnose_many(a.datasets, a.out, client=_client(a.scheduler), params=_params(a.params),
-                          library=a.library, force=a.force, progress=len(a.datasets) > 1)
+    client = _client(a.scheduler)
+    try:
+        table = diagnose_many(a.datasets, a.out, client=client, params=_params(a.params),
+                              library=a.library, force=a.force, progress=len(a.datasets) > 1)
+    finally:
+        if client is not None:
+            client.close()
     for row in table.rows:
         if row["error"]:
             print(f"{row['dataset']}: failed: {row['error']}")

@@ -10,7 +10,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 from . import _core
 from ._errors import InputError, PianoError
-from ._sweep import Progress, _progress_reporter
+from ._sweep import Progress, _cores, _progress_reporter
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -22,14 +22,18 @@ def diagnose(dataset: PathLike, out: PathLike, params: Optional[_core.Params] = 
     returns its report (``report.json``, which it writes into ``out`` with ``report.md``
     and ``report.html``): the decision (``named``, ``ambiguous``, ``none`` or
     ``unexplained``), the gap before and after, the candidates and the calibrated values.
-    The key ``"written"`` lists the files written. ``library`` names the effects to try
+    The key ``"written"`` lists the files written, and ``"params_refused"`` says why a
+    ``write_params`` file was not written (a model that does not explain the data, a value
+    at the edge of its search range), when it was not. ``library`` names the effects to try
     (comma-separated ids, all by default); ``write_params`` asks for the corrected
     parameter file (swing tests only); ``out`` is not replaced unless ``force``."""
-    written = _core.diagnose_to_disk(os.fspath(dataset), os.fspath(out), params, library,
-                                     None if write_params is None else os.fspath(write_params),
-                                     force)
+    written, refused = _core.diagnose_to_disk(
+        os.fspath(dataset), os.fspath(out), params, library,
+        None if write_params is None else os.fspath(write_params), force)
     report = json.loads((Path(out) / "report.json").read_text())
     report["written"] = written
+    if refused is not None:
+        report["params_refused"] = refused
     return report
 
 
@@ -107,8 +111,8 @@ def _diagnose_task(dataset: str, out: str, params: Optional[_core.Params],
     """One diagnosis (what a worker runs): its report, or the error as a string."""
     try:
         report = diagnose(dataset, out, params, library, None, force)
-    except PianoError as e:
-        return {"error": str(e)}
+    except (PianoError, _core.PanicException) as e:
+        return {"error": f"{e}" if isinstance(e, PianoError) else f"{type(e).__name__}: {e}"}
     try:
         experiment = json.loads((Path(dataset) / "dataset.json").read_text())["experiment"]
     except (OSError, ValueError, KeyError, TypeError):
@@ -135,7 +139,9 @@ def diagnose_many(datasets: Sequence[PathLike], out: PathLike, client: Any = Non
     datasets = [os.fspath(d) for d in datasets]
     if not datasets:
         raise InputError("diagnose_many: no datasets given")
-    names = [Path(d).name for d in datasets]
+    names = [Path(d).resolve().name for d in datasets]
+    if "" in names:
+        raise InputError("diagnose_many: a dataset is a folder with a name (not the root)")
     dupes = sorted({n for n in names if names.count(n) > 1})
     if dupes:
         raise InputError(f"diagnose_many: two datasets share the folder name {dupes[0]!r}, "
@@ -148,11 +154,13 @@ def diagnose_many(datasets: Sequence[PathLike], out: PathLike, client: Any = Non
     def finish(i: int, get: Callable[[], Dict[str, Any]]) -> None:
         try:
             results[i] = get()
-        except Exception as e:  # a lost worker, a killed task: this row fails
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as e:  # a lost worker, a cancelled task: this row fails
             results[i] = {"error": f"{type(e).__name__}: {e}"}
 
     if client is None:
-        with ThreadPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
+        with ThreadPoolExecutor(max_workers=workers or _cores()) as pool:
             futures = {pool.submit(_diagnose_task, d, o, params, library, force): i
                        for i, (d, o) in enumerate(zip(datasets, outs))}
             for k, fut in enumerate(as_completed(futures), 1):

@@ -13,6 +13,10 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 from . import _core
 from ._errors import InputError
 
+#: What fails one row rather than the whole sweep: an error, or a panic of the Rust code
+#: (which Python sees as a BaseException).
+FAILURES = (Exception, _core.PanicException)
+
 #: What a grid may hold (see :func:`sweep`).
 GRID_KEYS = ("touch", "values", "start", "stop", "runs", "linear", "duration_s", "model",
              "params", "set")
@@ -101,7 +105,9 @@ def _batch(items: Sequence[Tuple[Any, ...]], task: Callable[..., str]) -> List[s
     for item in items:
         try:
             rows.append(task(*item))
-        except Exception as e:  # this keystroke's row fails, not the batch
+        except InputError:
+            raise  # a wrong argument is the caller's, not this row's
+        except FAILURES as e:  # this keystroke's row fails, not the batch
             touch, value = item[0], item[1]
             rows.append(_core.sweep_failed_row(touch, value, f"{type(e).__name__}: {e}"))
     return rows
@@ -129,10 +135,19 @@ def _expand(grid: Mapping[str, Any]):
                                     int(grid.get("runs", 100)), bool(grid.get("linear", False)))
     duration_s = float(grid.get("duration_s", 0.3))
     model = grid.get("model", "double")
+    _core.check_sweep(model, duration_s)  # before any run, on any cluster
     base = grid.get("params") or _core.Params()
     if not isinstance(base, _core.Params):
         raise InputError(f"'params' is a piano_action.Params, got {type(base).__name__}")
     settings: Mapping[str, Sequence[float]] = grid.get("set") or {}
+    if not isinstance(settings, Mapping):
+        raise InputError("'set' maps parameter paths to lists of values, "
+                         f"got {type(settings).__name__}")
+    for p, vs in settings.items():
+        if isinstance(vs, (str, bytes)) or not hasattr(vs, "__iter__"):
+            raise InputError(f"'set': the values of {p} are a list, got {vs!r}")
+        if len(list(vs)) == 0:
+            raise InputError(f"'set': no values for {p}")
     paths = list(settings)
     combos: Iterable[Tuple[float, ...]] = itertools.product(
         *[[float(v) for v in settings[p]] for p in paths]) if paths else [()]
@@ -164,9 +179,11 @@ def sweep(grid: Mapping[str, Any], client: Any = None, progress: Progress = True
       (parameter sets outer, levels inner), its values in the first columns.
 
     With ``client`` (a ``dask.distributed.Client``: a ``LocalCluster`` on a laptop, or a
-    Slurm or PBS cluster from ``dask-jobqueue``), each keystroke is one task on the
-    cluster; without it, the keystrokes run on this machine's threads (``workers``, one per
-    core by default). Rows come back as they finish (``progress``: True prints a progress
+    Slurm or PBS cluster from ``dask-jobqueue``), the keystrokes run as tasks on the
+    cluster (``batch`` of them per task); without it, on this machine's threads
+    (``workers``, one per core this process may use by default). A wrong grid (a model, a
+    duration, a level, a parameter path or value) raises :class:`InputError` before any
+    run. Rows come back as they finish (``progress``: True prints a progress
     line to stderr, a callable gets ``(done, total)``, False nothing) and are put in the
     grid's order. A run that fails fails its own row (the ``error`` column says why), and a
     task the cluster loses fails the rows it held; the others go on. The numbers equal
@@ -187,7 +204,7 @@ def sweep(grid: Mapping[str, Any], client: Any = None, progress: Progress = True
         lines[i] = prefix + line
 
     if client is None:
-        n = workers or os.cpu_count() or 1
+        n = workers or _cores()
         with ThreadPoolExecutor(max_workers=n) as pool:
             futures = {pool.submit(_task, *t[1:]): i for i, t in enumerate(tasks)}
             from concurrent.futures import as_completed
@@ -215,7 +232,9 @@ def sweep(grid: Mapping[str, Any], client: Any = None, progress: Progress = True
                 rows = fut.result()
             except InputError:
                 raise
-            except BaseException as e:  # a lost worker, a killed task: its rows fail
+            except (KeyboardInterrupt, SystemExit):
+                raise
+            except BaseException as e:  # a lost worker, a cancelled task: its rows fail
                 rows = [_failed(tasks[i], e) for i in chunk]
             for i, line in zip(chunk, rows):
                 done(i, line)
@@ -231,7 +250,7 @@ def _line_or_failure(task, result: Callable[[], str]) -> str:
         return result()
     except InputError:
         raise
-    except Exception as e:
+    except FAILURES as e:
         return _failed(task, e)
 
 
@@ -239,6 +258,14 @@ def _failed(task, e: BaseException) -> str:
     """The row of a task that raised `e`: this row fails, not the sweep."""
     _, touch, value, _, _, _ = task
     return _core.sweep_failed_row(touch, value, f"{type(e).__name__}: {e}")
+
+
+def _cores() -> int:
+    """The cores this process may run on (a Slurm or cgroup allocation, not the machine's)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
 
 
 def _fmt(v: float) -> str:
@@ -251,9 +278,11 @@ def _progress_reporter(progress: Progress, total: int) -> Callable[[int], None]:
     if not progress:
         return lambda k: None
     step = max(1, total // 50)
+    shown = [0]
 
     def report(k: int) -> None:
-        if k % step == 0 or k == total:
+        if k - shown[0] >= step or k == total:
+            shown[0] = k
             width = 30
             filled = width * k // total
             sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {k}/{total} runs")
