@@ -186,6 +186,13 @@ impl Params {
         self.clone()
     }
 
+    /// Two parameter sets are equal when every value is (wherever they were read from).
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .extract::<Params>()
+            .is_ok_and(|o| o.inner == self.inner)
+    }
+
     /// The file these parameters were read from, if any.
     #[getter]
     fn file(&self) -> Option<String> {
@@ -271,16 +278,27 @@ impl ScenarioPy {
         })
     }
 
-    /// Parses a scenario from TOML text.
+    /// Parses a scenario from TOML text; the files it names (a mechanism description, a
+    /// motion's `csv`) are read relative to the folder `base` (the working folder by
+    /// default).
     #[staticmethod]
-    fn from_toml(text: &str) -> PyResult<Self> {
-        let inner = Scenario::from_toml_str(text).map_err(to_py)?;
+    #[pyo3(signature = (text, base=None))]
+    fn from_toml(text: &str, base: Option<PathBuf>) -> PyResult<Self> {
+        let base = base.unwrap_or_else(|| PathBuf::from("."));
+        let inner = Scenario::from_toml_str_in(text, &base, None).map_err(to_py)?;
         Ok(ScenarioPy { inner, file: None })
     }
 
-    /// The scenario as TOML text.
+    /// The scenario as TOML text, as its file says it (a motion read from a `csv` names
+    /// the file, not its points).
     fn to_toml(&self) -> PyResult<String> {
-        toml::to_string(&self.inner).map_err(|e| {
+        let mut s = self.inner.clone();
+        if let InputSpec::Motion(m) = &mut s.input
+            && m.csv.is_some()
+        {
+            m.points = None;
+        }
+        toml::to_string(&s).map_err(|e| {
             to_py(PianoError::scenario(
                 "",
                 format!("cannot write as TOML: {e}"),
@@ -416,8 +434,9 @@ impl RunPy {
         self.columns(py, 0, self.run.solution.n)
     }
 
-    /// The force driving the key front (N) at each output time, for inputs that have one
-    /// (touches); None otherwise.
+    /// Under a prescribed key motion (`kind = "motion"`), the vertical force the hand
+    /// applies at the finger point (N, pressing down positive) at each output time; None
+    /// for the other inputs.
     #[getter]
     fn key_drive_force_n<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
         let f = &self.run.key_drive_force_n;

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import piano_action as pa
@@ -101,3 +102,30 @@ def test_a_wrong_sweep_grid_raises_before_any_run():
                  {"touch": "force", "values": [5.0], "set": {"hammer.mass_gg": [11.0]}}):
         with pytest.raises(pa.InputError):
             pa.sweep(grid, progress=False)
+
+
+def test_wrong_sweep_arguments_name_the_argument():
+    cases = [({"touch": "pressed", "values": [1.0, float("nan")]}, "values[1]"),
+             ({"touch": "pressed", "values": [1.0, "a"]}, "values[1]"),
+             ({"touch": "pressed", "values": 5}, "values"),
+             ({"touch": "pressed", "runs": -5}, "runs"),
+             ({"touch": "pressed", "runs": 2.7}, "runs"),
+             ({"touch": "pressed", "velocity": 3}, "velocity")]
+    for grid, field in cases:
+        with pytest.raises(pa.InputError) as info:
+            pa.sweep(grid, progress=False)
+        assert info.value.field == field, (grid, str(info.value))
+        assert info.value.message and isinstance(info.value, ValueError)
+    with pytest.raises(pa.InputError) as info:
+        pa.diagnose_many(str(SCENARIOS), "out")
+    assert info.value.field == "datasets"
+
+
+def test_a_scenario_reads_back_what_it_writes():
+    s = pa.Scenario.load(SCENARIOS / "key_motion_csv.toml")
+    again = pa.Scenario.from_toml(s.to_toml(), base=SCENARIOS)
+    assert np.array_equal(pa.simulate(s).q, pa.simulate(again).q)
+    assert pa.Params() == pa.Params() and pa.Params() != 3
+    p = pa.Params()
+    p.set("hammer.mass_g", 12.0)
+    assert p != pa.Params()

@@ -154,6 +154,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     except PianoError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    except OSError as e:  # a Dask scheduler that does not answer, a file system error
+        print(f"error: {e}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -136,16 +136,22 @@ def diagnose_many(datasets: Sequence[PathLike], out: PathLike, client: Any = Non
     what ``piano diagnose DATASET --out out/<name>`` writes. ``out`` holding earlier
     reports is refused row by row unless ``force``.
     """
+    if isinstance(datasets, (str, bytes, os.PathLike)):
+        raise InputError("diagnose_many: 'datasets' is a list of dataset folders, got one "
+                         f"path ({os.fspath(datasets)!r}); pass [it]", field="datasets",
+                         kind="argument")
     datasets = [os.fspath(d) for d in datasets]
     if not datasets:
-        raise InputError("diagnose_many: no datasets given")
+        raise InputError("diagnose_many: no datasets given", field="datasets", kind="argument")
     names = [Path(d).resolve().name for d in datasets]
     if "" in names:
-        raise InputError("diagnose_many: a dataset is a folder with a name (not the root)")
+        raise InputError("diagnose_many: a dataset is a folder with a name (not the root)",
+                         field="datasets", kind="argument")
     dupes = sorted({n for n in names if names.count(n) > 1})
     if dupes:
         raise InputError(f"diagnose_many: two datasets share the folder name {dupes[0]!r}, "
-                         "so their reports would share a folder; rename one")
+                         "so their reports would share a folder; rename one",
+                         field="datasets", kind="argument")
     outs = [os.fspath(Path(out) / n) for n in names]
     total = len(datasets)
     results: List[Optional[Dict[str, Any]]] = [None] * total

@@ -20,6 +20,13 @@ class PianoError(Exception):
     field: Optional[str] = None
     message: Optional[str] = None
 
+    def __init__(self, message: str = "", *, field: Optional[str] = None,
+                 kind: Optional[str] = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.field = field
+        self.kind = kind
+
 
 class InputError(PianoError, ValueError):
     """A wrong value in an input: a parameter file, a scenario, a sweep's levels or an

@@ -63,7 +63,8 @@ class SweepTable:
         import numpy as np
 
         if name not in self.header:
-            raise InputError(f"no column '{name}' (columns: {', '.join(self.header)})")
+            raise InputError(f"no column '{name}' (columns: {', '.join(self.header)})",
+                             field=name, kind="argument")
         values = [r[name] for r in self.records()]
         if name in ("touch", "unit", "error"):
             return values
@@ -116,38 +117,63 @@ def _batch(items: Sequence[Tuple[Any, ...]], task: Callable[..., str]) -> List[s
 def _expand(grid: Mapping[str, Any]):
     """The grid's tasks: (parameter values, touch, level, duration, model, params)."""
     if not isinstance(grid, Mapping):
-        raise InputError(f"a sweep grid is a dict, got {type(grid).__name__}")
+        raise InputError(f"a sweep grid is a dict, got {type(grid).__name__}", field="grid",
+                         kind="argument")
     unknown = sorted(set(grid) - set(GRID_KEYS))
     if unknown:
         raise InputError(f"unknown grid key(s) {', '.join(unknown)} "
-                         f"(known: {', '.join(GRID_KEYS)})")
+                         f"(known: {', '.join(GRID_KEYS)})", field=unknown[0], kind="argument")
     touch = grid.get("touch", "struck")
     if "values" in grid:
         for k in ("start", "stop", "runs", "linear"):
             if k in grid:
-                raise InputError(f"give either 'values' or '{k}', not both")
-        values = [float(v) for v in grid["values"]]
+                raise InputError(f"give either 'values' or '{k}', not both", field=k,
+                                 kind="argument")
+        given = grid["values"]
+        if isinstance(given, (str, bytes)) or not hasattr(given, "__iter__"):
+            raise InputError(f"'values' is a list of levels, got {given!r}", field="values",
+                             kind="argument")
+        values = []
+        for i, v in enumerate(given):
+            try:
+                values.append(float(v))
+            except (TypeError, ValueError):
+                raise InputError(f"values[{i}]: {v!r} is not a number", field=f"values[{i}]",
+                                 kind="argument") from None
+            try:
+                _core.check_sweep_levels(touch, [values[-1]])
+            except InputError as e:
+                if e.field == "touch":
+                    raise
+                raise InputError(f"values[{i}]: {e.message}", field=f"values[{i}]",
+                                 kind="argument") from None
         if not values:
-            raise InputError("'values' is empty: a sweep needs at least one level")
-        _core.check_sweep_levels(touch, values)
+            raise InputError("'values' is empty: a sweep needs at least one level",
+                             field="values", kind="argument")
     else:
-        values = _core.sweep_levels(touch, grid.get("start"), grid.get("stop"),
-                                    int(grid.get("runs", 100)), bool(grid.get("linear", False)))
+        runs = grid.get("runs", 100)
+        if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
+            raise InputError(f"'runs' is a whole number of runs, at least 1, got {runs!r}",
+                             field="runs", kind="argument")
+        values = _core.sweep_levels(touch, grid.get("start"), grid.get("stop"), runs,
+                                    bool(grid.get("linear", False)))
     duration_s = float(grid.get("duration_s", 0.3))
     model = grid.get("model", "double")
     _core.check_sweep(model, duration_s)  # before any run, on any cluster
     base = grid.get("params") or _core.Params()
     if not isinstance(base, _core.Params):
-        raise InputError(f"'params' is a piano_action.Params, got {type(base).__name__}")
+        raise InputError(f"'params' is a piano_action.Params, got {type(base).__name__}",
+                         field="params", kind="argument")
     settings: Mapping[str, Sequence[float]] = grid.get("set") or {}
     if not isinstance(settings, Mapping):
         raise InputError("'set' maps parameter paths to lists of values, "
-                         f"got {type(settings).__name__}")
+                         f"got {type(settings).__name__}", field="set", kind="argument")
     for p, vs in settings.items():
         if isinstance(vs, (str, bytes)) or not hasattr(vs, "__iter__"):
-            raise InputError(f"'set': the values of {p} are a list, got {vs!r}")
+            raise InputError(f"'set': the values of {p} are a list, got {vs!r}",
+                             field=f"set.{p}", kind="argument")
         if len(list(vs)) == 0:
-            raise InputError(f"'set': no values for {p}")
+            raise InputError(f"'set': no values for {p}", field=f"set.{p}", kind="argument")
     paths = list(settings)
     combos: Iterable[Tuple[float, ...]] = itertools.product(
         *[[float(v) for v in settings[p]] for p in paths]) if paths else [()]
@@ -203,6 +229,9 @@ def sweep(grid: Mapping[str, Any], client: Any = None, progress: Progress = True
         prefix = "".join(f"{_fmt(v)}," for v in combo)
         lines[i] = prefix + line
 
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise InputError(f"'workers' is a number of threads, at least 1, got {workers!r}",
+                         field="workers", kind="argument")
     if client is None:
         n = workers or _cores()
         with ThreadPoolExecutor(max_workers=n) as pool:
@@ -219,8 +248,9 @@ def sweep(grid: Mapping[str, Any], client: Any = None, progress: Progress = True
         if batch is None:
             threads = sum(client.nthreads().values()) or 1
             batch = max(1, -(-total // (4 * threads)))
-        if batch < 1:
-            raise InputError(f"batch: a task holds at least one keystroke, got {batch}")
+        if not isinstance(batch, int) or batch < 1:
+            raise InputError(f"batch: a task holds at least one keystroke, got {batch!r}",
+                             field="batch", kind="argument")
         chunks = [list(range(i, min(i + batch, total))) for i in range(0, total, batch)]
         futures = client.map(_batch, [[tasks[i][1:] for i in c] for c in chunks],
                              task=_task, pure=False)
