@@ -105,7 +105,15 @@ pub fn solve_observed(
     run.output_point(t0, y0);
     run.init_events(t0, y0)?;
     let mut termination = Termination::Finished;
+    let mut since_check = 0;
     while stepper.t() < t_end {
+        since_check += 1;
+        if since_check >= crate::interrupt::EVERY {
+            since_check = 0;
+            if crate::interrupt::interrupted() {
+                return Err(IntegratorError::Interrupted { t: stepper.t() });
+            }
+        }
         if run.stats.steps >= opts.max_steps {
             return Err(IntegratorError::TooManySteps {
                 t: stepper.t(),

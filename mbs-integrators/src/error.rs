@@ -77,6 +77,12 @@ pub enum IntegratorError {
         /// The limit.
         max_steps: usize,
     },
+    /// The check of [`crate::with_interrupt_check`] asked to stop.
+    #[error("at t = {t}: interrupted")]
+    Interrupted {
+        /// Time reached.
+        t: f64,
+    },
     /// The system reported an error.
     #[error("at t = {t}: the system failed: {source}")]
     System {

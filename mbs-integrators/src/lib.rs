@@ -52,6 +52,7 @@ mod dopri5;
 mod driver;
 mod error;
 mod explicit;
+mod interrupt;
 mod jacobian;
 mod linalg;
 mod multibody;
@@ -65,6 +66,7 @@ mod trbdf2;
 
 pub use driver::{solve, solve_observed, solve_with_events};
 pub use error::{IntegratorError, Result, SystemError};
+pub use interrupt::with_interrupt_check;
 pub use multibody::MultibodyOde;
 pub use ode::{Crossing, EventSource, OdeSystem};
 pub use options::{Method, Options};

@@ -340,3 +340,44 @@ fn fixed_steps_do_not_leave_a_sliver_at_the_end() {
     assert_eq!(sol.stats.steps, 1000);
     assert_eq!(sol.t_final, 100.0);
 }
+
+/// ẏ = −y, solved with fixed small steps: thousands of steps to an interrupt check.
+struct Decay;
+
+impl OdeSystem for Decay {
+    fn len(&self) -> usize {
+        1
+    }
+    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SystemError> {
+        dy[0] = -y[0];
+        Ok(())
+    }
+}
+
+static CHECKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Says "stop" at its third call.
+fn stop_at_third() -> bool {
+    CHECKS.fetch_add(1, std::sync::atomic::Ordering::SeqCst) >= 2
+}
+
+#[test]
+fn an_interrupt_check_stops_a_solve_and_is_removed_afterwards() {
+    let opts = Options {
+        fixed_step: Some(1e-4),
+        ..Options::default()
+    };
+    let run = || solve(&mut Decay, Method::Rk4, 0.0, &[1.0], 1.0, &opts);
+    let e = mbs_integrators::with_interrupt_check(stop_at_third, run).unwrap_err();
+    let IntegratorError::Interrupted { t } = e else {
+        panic!("unexpected {e:?}");
+    };
+    // Three checks, a few hundred steps apart: stopped early, not at the end.
+    assert!(t > 0.0 && t < 0.5, "stopped at t = {t}");
+    assert_eq!(CHECKS.load(std::sync::atomic::Ordering::SeqCst), 3);
+    assert!(e.to_string().contains("interrupted"), "{e}");
+    // Outside it, nothing is checked: the same solve runs to the end.
+    let sol = run().unwrap();
+    assert_eq!(sol.t.last().copied(), Some(1.0));
+    assert_eq!(CHECKS.load(std::sync::atomic::Ordering::SeqCst), 3);
+}

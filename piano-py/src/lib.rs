@@ -26,9 +26,39 @@ pyo3::import_exception!(piano_action._errors, InputError);
 pyo3::import_exception!(piano_action._errors, PianoFileError);
 pyo3::import_exception!(piano_action._errors, SimulationError);
 
+thread_local! {
+    /// The exception a signal handler raised while a solve on this thread was running
+    /// (Ctrl-C's `KeyboardInterrupt`): given back instead of the solve's "interrupted".
+    static PENDING: std::cell::RefCell<Option<PyErr>> = const { std::cell::RefCell::new(None) };
+}
+
+/// The interrupt check of the solves run from Python: Python's signal handlers run (on the
+/// main thread), and one that raises (Ctrl-C) stops the solve.
+fn python_interrupted() -> bool {
+    Python::attach(|py| match py.check_signals() {
+        Ok(()) => false,
+        Err(e) => {
+            PENDING.with(|p| *p.borrow_mut() = Some(e));
+            true
+        }
+    })
+}
+
+/// Runs `f` with the GIL released, stoppable by Ctrl-C (see [`python_interrupted`]).
+fn detach_interruptible<T, F>(py: Python<'_>, f: F) -> T
+where
+    F: Send + FnOnce() -> T,
+    T: Send,
+{
+    py.detach(move || mbs_integrators::with_interrupt_check(python_interrupted, f))
+}
+
 /// The Python exception for `e`, with its attributes set: `kind`, `file`, `line`, `field`
 /// and `message` (None where they do not apply).
 fn to_py(e: PianoError) -> PyErr {
+    if let Some(raised) = PENDING.with(|p| p.borrow_mut().take()) {
+        return raised;
+    }
     Python::attach(|py| {
         let text = e.to_string();
         let (err, kind, file, line, field, message) = match &e {
@@ -532,29 +562,28 @@ impl RunPy {
     /// action at rest, a few milliseconds), with the GIL released.
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let (params, scenario, run) = (&self.params, &self.scenario, &self.run);
-        let table = py
-            .detach(|| {
-                let input = scenario.input.to_input()?;
-                let prepared = prepare(params, run.kind, &input)?;
-                let action = &prepared.action;
-                let sol = &run.solution;
-                let mut out = Vec::new();
-                for name in action.contacts.keys() {
-                    let mut cols: [Vec<f64>; 6] = Default::default();
-                    let mut active = Vec::with_capacity(sol.len());
-                    for i in 0..sol.len() {
-                        let o = action.contact_output(name, sol.t[i], sol.state(i))?;
-                        let vals = piano_action::scenario::contact_columns(&o);
-                        for (c, v) in cols.iter_mut().zip(vals) {
-                            c.push(v);
-                        }
-                        active.push(o.active);
+        let table = detach_interruptible(py, || {
+            let input = scenario.input.to_input()?;
+            let prepared = prepare(params, run.kind, &input)?;
+            let action = &prepared.action;
+            let sol = &run.solution;
+            let mut out = Vec::new();
+            for name in action.contacts.keys() {
+                let mut cols: [Vec<f64>; 6] = Default::default();
+                let mut active = Vec::with_capacity(sol.len());
+                for i in 0..sol.len() {
+                    let o = action.contact_output(name, sol.t[i], sol.state(i))?;
+                    let vals = piano_action::scenario::contact_columns(&o);
+                    for (c, v) in cols.iter_mut().zip(vals) {
+                        c.push(v);
                     }
-                    out.push((name.clone(), cols, active));
+                    active.push(o.active);
                 }
-                Ok::<_, PianoError>(out)
-            })
-            .map_err(to_py)?;
+                out.push((name.clone(), cols, active));
+            }
+            Ok::<_, PianoError>(out)
+        })
+        .map_err(to_py)?;
         let d = PyDict::new(py);
         for (name, cols, active) in table {
             let c = PyDict::new(py);
@@ -719,8 +748,7 @@ impl MechanismRunPy {
     /// pressed), `px_mm`, `py_mm`, `nx` and `ny` (None for a contact without numbers).
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let run = &self.run;
-        let series = py
-            .detach(|| piano_action::mechanism_run::contact_series(run))
+        let series = detach_interruptible(py, || piano_action::mechanism_run::contact_series(run))
             .map_err(to_py)?;
         let d = PyDict::new(py);
         for (name, rows) in series {
@@ -878,30 +906,26 @@ fn run_scenario(py: Python<'_>, scenario: ScenarioPy, params: ActionParams) -> P
         None => e,
     };
     if s.loaded_mechanism.is_some() {
-        let run = py
-            .detach(|| s.run_mechanism(&params, &mut |_| {}))
+        let run = detach_interruptible(py, || s.run_mechanism(&params, &mut |_| {}))
             .map_err(|e| to_py(in_file(e)))?;
         return Ok(Py::new(py, MechanismRunPy { run })?.into_any());
     }
     if let InputSpec::Pendulum(spec) = &s.input {
-        let swing = py
-            .detach(|| {
-                piano_action::pendulum::swing_sampled(
-                    &params,
-                    spec.release_angle_deg,
-                    s.duration_s,
-                    s.output_step_s,
-                )
-            })
-            .map_err(|e| to_py(in_file(e)))?;
+        let swing = detach_interruptible(py, || {
+            piano_action::pendulum::swing_sampled(
+                &params,
+                spec.release_angle_deg,
+                s.duration_s,
+                s.output_step_s,
+            )
+        })
+        .map_err(|e| to_py(in_file(e)))?;
         return Ok(Py::new(py, SwingPy { swing, params })?.into_any());
     }
     let kind = s.model_kind().map_err(to_py)?;
     let input = s.input.to_input().map_err(to_py)?;
     let names = piano_action::simulate::coordinate_names(&params, kind, &input).map_err(to_py)?;
-    let run = py
-        .detach(|| s.run(&params))
-        .map_err(|e| to_py(in_file(e)))?;
+    let run = detach_interruptible(py, || s.run(&params)).map_err(|e| to_py(in_file(e)))?;
     Ok(Py::new(
         py,
         RunPy {
@@ -1118,7 +1142,7 @@ fn sweep_row(
     piano_action::simulate::check_duration(duration_s, 1e-3).map_err(to_py)?;
     check_levels(kind, &[value]).map_err(to_py)?;
     let params = params_or_reference(params.as_ref());
-    let row = py.detach(|| SweepRow {
+    let row = detach_interruptible(py, || SweepRow {
         value,
         run: simulate_input(&params, model, &kind.input(value), duration_s, 1e-3)
             .map_err(|e| e.to_string()),
@@ -1162,8 +1186,7 @@ fn touchweight<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let kind = model_kind(model)?;
     let params = params_or_reference(params.as_ref());
-    let w = py
-        .detach(|| piano_action::touchweight::measure(&params, kind))
+    let w = detach_interruptible(py, || piano_action::touchweight::measure(&params, kind))
         .map_err(to_py)?;
     json_to_py(py, &w.to_json())
 }
@@ -1181,15 +1204,14 @@ fn regulate<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let kind = model_kind(model)?;
     let base = params_or_reference(params.as_ref());
-    let done = py
-        .detach(|| {
-            piano_action::regulation::regulate(
-                &base,
-                kind,
-                &piano_action::regulation::Targets::default(),
-            )
-        })
-        .map_err(to_py)?;
+    let done = detach_interruptible(py, || {
+        piano_action::regulation::regulate(
+            &base,
+            kind,
+            &piano_action::regulation::Targets::default(),
+        )
+    })
+    .map_err(to_py)?;
     let out = json_to_py(py, &done.to_json(kind).map_err(to_py)?)?;
     let regulated = Params {
         inner: done.params,
@@ -1212,9 +1234,10 @@ fn validate<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let kind = model_kind(model)?;
     let params = params_or_reference(params.as_ref());
-    let v = py
-        .detach(|| piano_action::validate::validate_with_known(&params, kind))
-        .map_err(to_py)?;
+    let v = detach_interruptible(py, || {
+        piano_action::validate::validate_with_known(&params, kind)
+    })
+    .map_err(to_py)?;
     json_to_py(py, &v.to_json())
 }
 
@@ -1255,9 +1278,10 @@ fn synth<'py>(
         duration_s,
     };
     let params = params_or_reference(params.as_ref());
-    let done = py
-        .detach(|| synth_request_to_disk(&params, &request, &out, &truth, force))
-        .map_err(to_py)?;
+    let done = detach_interruptible(py, || {
+        synth_request_to_disk(&params, &request, &out, &truth, force)
+    })
+    .map_err(to_py)?;
     let d = PyDict::new(py);
     d.set_item("dataset", out.display().to_string())?;
     d.set_item("truth", truth.display().to_string())?;
@@ -1291,20 +1315,19 @@ fn diagnose_to_disk(
     let base = params_or_reference(params.as_ref());
     let source = params.as_ref().map_or(Ok(None), |p| p.source_text())?;
     let source = source.unwrap_or_else(|| piano_action::params::DEFAULT_PARAMS_TOML.to_string());
-    let done = py
-        .detach(|| {
-            piano_action::identify::commands::diagnose_dataset_to_disk(
-                &base,
-                &source,
-                &dataset,
-                library.as_deref(),
-                &out,
-                write_params.as_deref(),
-                force,
-                &|_: &str, _: f64| {},
-            )
-        })
-        .map_err(to_py)?;
+    let done = detach_interruptible(py, || {
+        piano_action::identify::commands::diagnose_dataset_to_disk(
+            &base,
+            &source,
+            &dataset,
+            library.as_deref(),
+            &out,
+            write_params.as_deref(),
+            force,
+            &|_: &str, _: f64| {},
+        )
+    })
+    .map_err(to_py)?;
     let refused = match &done {
         piano_action::identify::commands::Diagnosed::Pendulum(o) => o.params_refused.clone(),
         piano_action::identify::commands::Diagnosed::KeyDrive(..) => None,

@@ -231,3 +231,24 @@ def test_python_m_piano_action_simulates_every_kind_of_scenario():
         assert done.returncode == 0, done.stderr
         assert ("strike at" in done.stdout) if name == "struck_forte" else \
             ("turning points" in done.stdout)
+
+
+def test_ctrl_c_stops_a_simulation():
+    import _thread
+
+    # A friction regularization this fine makes a keystroke take minutes (it then fails at
+    # the step budget); Ctrl-C, simulated here, stops it at the next check.
+    p = pa.Params()
+    p.set("numerics.friction_regularization_m_s", 1e-12)
+    p.set("numerics.pivot_friction_regularization_rad_s", 1e-12)
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            pa.simulate({"model": "double", "duration_s": 0.3,
+                         "input": {"kind": "touch", "style": "pressed", "peak_force_n": 10.0}},
+                        p)
+    finally:
+        timer.cancel()
+    # Nothing is left behind: the next run is as before.
+    assert pa.simulate(SCENARIOS / "struck_forte.toml").strikes
