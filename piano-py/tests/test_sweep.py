@@ -171,3 +171,10 @@ def test_diagnose_many_on_the_cluster(client, tmp_path, piano):
     cli = json.loads((tmp_path / "cli" / "report.json").read_text())
     assert without_timing(table.reports[0]) == without_timing(cli)
     assert table.to_csv().splitlines()[0].startswith("dataset,out,experiment,decision")
+
+
+def test_the_progress_line_of_a_log_is_a_line_per_tenth(capsys):
+    pa.sweep({"touch": "force", "values": [5.0, 10.0, 20.0], "duration_s": 0.05})
+    err = capsys.readouterr().err
+    assert "\r" not in err  # stderr is not a terminal here
+    assert err.splitlines() == ["1/3 runs done", "2/3 runs done", "3/3 runs done"]

@@ -155,7 +155,7 @@ def diagnose_many(datasets: Sequence[PathLike], out: PathLike, client: Any = Non
     outs = [os.fspath(Path(out) / n) for n in names]
     total = len(datasets)
     results: List[Optional[Dict[str, Any]]] = [None] * total
-    report = _progress_reporter(progress, total)
+    report = _progress_reporter(progress, total, "diagnoses")
 
     def finish(i: int, get: Callable[[], Dict[str, Any]]) -> None:
         try:

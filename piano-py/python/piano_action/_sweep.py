@@ -302,22 +302,30 @@ def _fmt(v: float) -> str:
     return _core.format_number(v)
 
 
-def _progress_reporter(progress: Progress, total: int) -> Callable[[int], None]:
+def _progress_reporter(progress: Progress, total: int,
+                       what: str = "runs") -> Callable[[int], None]:
+    """What `progress` asks for, called with the number done: a callable gets
+    ``(done, total)``; True draws a bar on stderr when it is a terminal, and otherwise
+    writes a line at every tenth (a log stays readable); False nothing."""
     if callable(progress):
         return lambda k: progress(k, total)
     if not progress:
         return lambda k: None
-    step = max(1, total // 50)
+    terminal = sys.stderr.isatty()
+    step = max(1, total // (50 if terminal else 10))
     shown = [0]
 
     def report(k: int) -> None:
         if k - shown[0] >= step or k == total:
             shown[0] = k
-            width = 30
-            filled = width * k // total
-            sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {k}/{total} runs")
-            if k == total:
-                sys.stderr.write("\n")
+            if terminal:
+                width = 30
+                filled = width * k // total
+                sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {k}/{total} {what}")
+                if k == total:
+                    sys.stderr.write("\n")
+            else:
+                sys.stderr.write(f"{k}/{total} {what} done\n")
             sys.stderr.flush()
 
     return report
