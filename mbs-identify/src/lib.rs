@@ -8,15 +8,18 @@
 //! names the file, the line and the field ([`DatasetError`]); nothing panics on a bad file.
 //! And the **camera**'s measurement model: a frame averages the motion over its exposure,
 //! shifted by the camera's unknown clock offset ([`Camera`]). The calibration's optimiser
-//! is [`lm`], the noise model [`noise`], and [`work`] counts a job's fits and simulations
+//! is [`lm`], the noise model [`noise`], whether a model explains the data to the noise
+//! [`explain`] (with the χ² tail it needs in [`stats`]), and [`work`] counts a job's fits and simulations
 //! per stage and reports their rates.
 
 mod camera;
 mod dataset;
 mod effect;
+pub mod explain;
 pub mod lm;
 pub mod noise;
 mod rng;
+pub mod stats;
 pub mod work;
 
 pub use camera::Camera;

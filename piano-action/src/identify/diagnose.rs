@@ -15,6 +15,9 @@ use std::collections::BTreeMap;
 
 use rayon::prelude::*;
 
+use mbs_identify::explain::{
+    NoiseCheck, NoiseCheckOptions, Residual, RunResiduals, Window, check_noise,
+};
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
 use mbs_identify::work::{StageClock, StageWork, WorkCounter};
@@ -165,10 +168,20 @@ pub struct NamedEffect {
 /// The diagnosis (`report.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct Diagnosis {
-    /// `named`, `ambiguous`, `none` or `unexplained`.
+    /// `named`, `ambiguous`, `partly_explained`, `none` or `unexplained`.
     pub decision: String,
     /// One sentence on why.
     pub summary: String,
+    /// The candidate that explains the most when the decision is `partly_explained` (or
+    /// the named one): never added to the model unless named.
+    pub best_candidate: Option<String>,
+    /// How many times the best candidate shrinks the flagged phase's gap.
+    pub flagged_shrink: Option<f64>,
+    /// Whether the best candidate's model explains every run to the noise (every phase,
+    /// and the residuals' whiteness): the test a name must pass.
+    pub noise_check: Option<NoiseCheck>,
+    /// The same test of the calibrated baseline.
+    pub baseline_noise_check: NoiseCheck,
     /// The effect(s) added (one when named; the best of the set when ambiguous).
     pub effects: Vec<NamedEffect>,
     /// The other effects an ambiguity could not separate from the first.
@@ -655,6 +668,46 @@ pub fn diagnose(
             .filter(|(o, _)| (w.t0..w.t1).contains(&r.times[o.frame]))
             .map(|(_, e)| *e))
     };
+    // Whether a model (its fitted and held-out runs' raw residuals) explains every run to
+    // the noise, phase by phase (`mbs_identify::explain`).
+    let noise_check = |fit: &[Vec<f64>], held: &[Vec<f64>]| -> NoiseCheck {
+        let runs: Vec<RunResiduals> = problem
+            .runs
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let raw = residuals_of(i, fit, held);
+                let standardized: Vec<f64> = raw.iter().map(|e| e / sigma).collect();
+                let starts: Vec<bool> = r.obs.iter().map(|o| o.segment_start).collect();
+                let whitened = noise::whiten(&standardized, &starts, problem.noise.rho);
+                RunResiduals {
+                    run: r.id.clone(),
+                    phases: windows
+                        .iter()
+                        .filter(|w| w.run == i)
+                        .map(|w| Window {
+                            name: w.name.clone(),
+                            t0_s: w.t0,
+                            t1_s: w.t1,
+                        })
+                        .collect(),
+                    residuals: r
+                        .obs
+                        .iter()
+                        .zip(standardized.iter().zip(&whitened))
+                        .map(|(o, (&s, &w))| Residual {
+                            marker: o.marker,
+                            time_s: r.times[o.frame],
+                            standardized: s,
+                            whitened: w,
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        let names: Vec<String> = dataset.markers.iter().map(|m| m.name.clone()).collect();
+        check_noise(&runs, &names, &NoiseCheckOptions::default())
+    };
     let mut flagged: Option<(usize, f64)> = None;
     for (k, w) in windows.iter().enumerate() {
         if problem.runs[w.run].role != Role::Fit {
@@ -854,6 +907,24 @@ pub fn diagnose(
         })
         .collect();
     let verdict = decide(&contenders, base_worst_floors);
+    // No name without the data explained (issue 33): the best's model must bring every
+    // run to the noise and shrink the flagged phase's gap twice or more.
+    let base_check = noise_check(&base_fit_raw, &base_heldout_raw);
+    let best_of = |v: &Verdict| match v {
+        Verdict::Named(i) | Verdict::Ambiguous(i, _) | Verdict::Partial(i, _) => Some(kept[*i]),
+        Verdict::None | Verdict::Unexplained => None,
+    };
+    let best = best_of(&verdict);
+    let best_check = best.map(|t| noise_check(&t.fit_raw, &t.heldout_raw));
+    let shrink = best.map(|t| flagged_before / flagged_rms(&t.fit_raw, &t.heldout_raw).max(1e-300));
+    let explains = best_check.as_ref().is_some_and(|c| c.explained)
+        && shrink.is_some_and(|x| x >= super::key_diagnose::SHRINK_MIN);
+    let verdict = match verdict {
+        Verdict::Named(i) | Verdict::Ambiguous(i, _) if !explains => {
+            Verdict::Partial(i, best_check.as_ref().map_or(f64::NAN, worst_floors))
+        }
+        v => v,
+    };
     let mut ambiguous_with = Vec::new();
     let mut separating = None;
     let chosen = match &verdict {
@@ -861,15 +932,40 @@ pub fn diagnose(
         Verdict::None | Verdict::Unexplained => None,
     };
     let (decision, summary) = match &verdict {
-        Verdict::Partial(i, floors) => (
-            "unexplained".to_string(),
-            format!(
-                "{} explains the fitted run but the held-out run keeps a gap of {floors:.1} \
-                 noise floors before its last swings: something outside the library (or a \
-                 look-alike)",
-                kept[*i].spec.id
-            ),
-        ),
+        Verdict::Partial(i, _) => {
+            let x = shrink.unwrap_or(1.0);
+            let mut left = Vec::new();
+            if let Some(floors) = contenders[*i]
+                .heldout_floors
+                .filter(|f| *f > PARTIAL_FLOORS)
+            {
+                left.push(format!(
+                    "the held-out run keeps a gap of {floors:.1} noise floors before its last \
+                     swings (a look-alike of something outside the library)"
+                ));
+            }
+            if x < super::key_diagnose::SHRINK_MIN {
+                left.push(format!(
+                    "it shrinks the flagged phase's gap only {x:.1}× (needs {}×)",
+                    super::key_diagnose::SHRINK_MIN
+                ));
+            }
+            if let Some(c) = best_check.as_ref().filter(|c| !c.explained) {
+                left.push(format!("left: {}", c.summary()));
+            }
+            (
+                "partly_explained".to_string(),
+                format!(
+                    "{} takes {:.0} % of the gap in {} ({:.1} → {:.1} µm), but {}",
+                    kept[*i].spec.id,
+                    100.0 * (1.0 - (1.0 / (x * x)).min(1.0)),
+                    flagged_window.map_or("the data", |w| w.name.as_str()),
+                    flagged_before * 1e6,
+                    flagged_before / x * 1e6,
+                    left.join("; ")
+                ),
+            )
+        }
         Verdict::Named(i) => (
             "named".to_string(),
             format!(
@@ -987,6 +1083,10 @@ pub fn diagnose(
     let mut throughput = clock.stages();
     throughput.push(clock.total());
     Ok(Diagnosis {
+        best_candidate: best.map(|t| t.spec.id.to_string()),
+        flagged_shrink: shrink,
+        noise_check: best_check,
+        baseline_noise_check: base_check,
         decision,
         summary,
         effects,
@@ -1007,6 +1107,13 @@ pub fn diagnose(
     })
 }
 
+/// The largest gap, plain or whitened, of the cells a noise check failed (noise floors).
+fn worst_floors(c: &NoiseCheck) -> f64 {
+    c.worst
+        .as_ref()
+        .map_or(0.0, |w| w.floors.max(w.whitened_rms))
+}
+
 /// A candidate that passed every rule, as the decision sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contender {
@@ -1024,9 +1131,10 @@ pub enum Verdict {
     Named(usize),
     /// The best and the others within [`AMBIGUITY_BIC`] of it.
     Ambiguous(usize, Vec<usize>),
-    /// The best explains the fitted runs but not the held-out one (this many noise
-    /// floors left): a look-alike of something outside the library. Reported as
-    /// `unexplained`.
+    /// The best explains part of the gap only: the held-out one keeps this many noise
+    /// floors (a look-alike of something outside the library), or its model leaves a
+    /// phase or the residuals' whiteness beyond the noise, or it shrinks the flagged gap
+    /// less than twice. Reported as `partly_explained`.
     Partial(usize, f64),
     /// Nothing kept, and the baseline is within [`EXPLAINED_FLOORS`] everywhere.
     None,
