@@ -422,7 +422,7 @@ pub fn diagnose_to_disk(
     let dataset = Dataset::load(dir).map_err(super::diagnose::dataset_error)?;
     let d = diagnose(params, &dataset, options, progress)?;
     let mut written = super::report::write_pages(&d, dir, out, force)?;
-    let refusal = if d.decision == "unexplained" {
+    let refusal = if d.decision == "unexplained" || d.decision == "partly_explained" {
         Some(
             "no parameter file written: the model does not explain the data, so its \
              calibrated values are not to be trusted"

@@ -16,7 +16,7 @@
   R.markers.forEach((m, i) => zoomSel.add(new Option('around ' + m, i)));
   [1, 10, 100].forEach((g) => gainSel.add(new Option('gap ×' + g, g)));
   gainSel.value = 10;
-  const colors = { baseline: '#888', corrected: '#1f77b4' };
+  const colors = { baseline: '#888', corrected: '#1f77b4', 'best candidate': '#e67e22' };
 
   function bounds() {
     const b = { x0: Infinity, x1: -Infinity, y0: Infinity, y1: -Infinity };

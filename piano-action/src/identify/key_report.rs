@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use super::key_diagnose::KeyDriveDiagnosis;
 use super::report::{
-    FILES, calibrated_table, check_out_dir, data_items, generator_mark, throughput_html,
-    throughput_markdown,
+    FILES, OUTCOMES, calibrated_table, check_out_dir, data_items, generator_mark, noise_check_html,
+    noise_check_markdown, throughput_html, throughput_markdown,
 };
 use crate::error::{PianoError, Result};
 use crate::validate::page::PAGE_STYLE;
@@ -113,6 +113,7 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     let _ = writeln!(s, "{}", generator_mark("report.md"));
     let _ = writeln!(s, "# Key-drive diagnosis of {}\n", dataset.display());
     let _ = writeln!(s, "**Decision: {}.** {}\n", d.decision, d.summary);
+    let _ = writeln!(s, "*Outcomes.* {OUTCOMES}.\n");
     for e in &d.effects {
         let _ = write!(s, "Effect `{}`:", e.id);
         for (name, v) in &e.params {
@@ -176,6 +177,21 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             um(p.before_rms_m),
             um(p.after_rms_m)
         );
+    }
+    s.push('\n');
+    if let Some(c) = &d.noise_check {
+        s.push_str(&noise_check_markdown(
+            &format!(
+                "Does {} explain the data to the noise?",
+                d.best_candidate.as_deref().unwrap_or("the best candidate")
+            ),
+            c,
+        ));
+    } else {
+        s.push_str(&noise_check_markdown(
+            "Does the calibrated baseline explain the data to the noise?",
+            &d.baseline_noise_check,
+        ));
     }
     s.push_str("\n## Candidates\n\n| effect | ΔBIC (whitened) | fit (µm) | held-out (µm) | parameters | kept | why | compute (core-s: screening + refit) |\n|---|---|---|---|---|---|---|---|\n");
     for c in &d.candidates {
@@ -263,7 +279,11 @@ pub fn charts(d: &KeyDriveDiagnosis) -> Vec<Chart> {
         ];
         if let Some(after) = after {
             series.push(Series {
-                label: "corrected".into(),
+                label: if d.decision == "partly_explained" {
+                    "best candidate (not named)".into()
+                } else {
+                    "corrected".into()
+                },
                 color: "#1f77b4",
                 points: thin(&tr.t, after.into_iter(), step),
                 mark: Mark::Line { dashed: false },
@@ -291,12 +311,13 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
          <style>{PAGE_STYLE}.decision{{font-size:17px;padding:8px 12px;background:#f4f8fc;border-left:4px solid #1f77b4}}\
          #replay{{width:100%;max-width:980px;height:560px;border:1px solid #ccc;display:block}}\
          .controls{{margin:6px 0}} .controls *{{margin-right:8px}}</style>\n\
-         </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n",
+         </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n<p><i>Outcomes.</i> {}.</p>\n",
         generator_mark("report.html"),
         escape(&title),
         escape(&title),
         escape(&d.decision),
-        escape(&d.summary)
+        escape(&d.summary),
+        escape(OUTCOMES)
     );
     for e in &d.effects {
         let _ = write!(s, "<p>Effect <code>{}</code>: ", escape(&e.id));
@@ -351,7 +372,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     if let Some(replay) = &d.replay {
         s.push_str(
             "<h2>Replay</h2>\n<p>The action as the baseline (grey) and the corrected model \
-             (blue) move it; crosses: the models' markers; red dots: the measured markers, \
+             (blue; orange: the best candidate when it explains only part of the gap) move it; crosses: the models' markers; red dots: the measured markers, \
              their gap to each model magnified.</p>\n<div class=\"controls\"><select \
              id=\"replay-run\"></select><select id=\"replay-zoom\"></select><select \
              id=\"replay-gain\"></select><button id=\"replay-play\">play</button><input \
@@ -389,7 +410,22 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             um(p.after_rms_m)
         );
     }
-    s.push_str("</tbody></table>\n<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th><th>compute (core-s: screening + refit)</th></tr></thead><tbody>\n");
+    s.push_str("</tbody></table>\n");
+    if let Some(c) = &d.noise_check {
+        s.push_str(&noise_check_html(
+            &format!(
+                "Does {} explain the data to the noise?",
+                d.best_candidate.as_deref().unwrap_or("the best candidate")
+            ),
+            c,
+        ));
+    } else {
+        s.push_str(&noise_check_html(
+            "Does the calibrated baseline explain the data to the noise?",
+            &d.baseline_noise_check,
+        ));
+    }
+    s.push_str("<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th><th>compute (core-s: screening + refit)</th></tr></thead><tbody>\n");
     for c in &d.candidates {
         let params: Vec<String> = c
             .params

@@ -5,6 +5,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use mbs_identify::explain::{CellCheck, NoiseCheck};
 use mbs_identify::work::StageWork;
 
 use super::diagnose::Diagnosis;
@@ -79,6 +80,7 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
     let _ = writeln!(s, "{}", generator_mark("report.md"));
     let _ = writeln!(s, "# Diagnosis of {}\n", dataset.display());
     let _ = writeln!(s, "**Decision: {}.** {}\n", d.decision, d.summary);
+    let _ = writeln!(s, "*Outcomes.* {OUTCOMES}.\n");
     if !d.at_bound.is_empty() {
         let _ = writeln!(
             s,
@@ -145,6 +147,20 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
             um(p.before_rms_m),
             um(p.after_rms_m)
         );
+    }
+    if let Some(c) = &d.noise_check {
+        s.push_str(&noise_check_markdown(
+            &format!(
+                "Does {} explain the data to the noise?",
+                d.best_candidate.as_deref().unwrap_or("the best candidate")
+            ),
+            c,
+        ));
+    } else {
+        s.push_str(&noise_check_markdown(
+            "Does the calibrated baseline explain the data to the noise?",
+            &d.baseline_noise_check,
+        ));
     }
     let _ = writeln!(s, "\n## Candidates\n");
     let _ = writeln!(
@@ -323,12 +339,13 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          {}\n<title>{}</title>\n\
          <style>{PAGE_STYLE}.decision{{font-size:17px;padding:8px 12px;background:#f4f8fc;border-left:4px solid #1f77b4}}</style>\n\
-         </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n",
+         </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n<p><i>Outcomes.</i> {}.</p>\n",
         generator_mark("report.html"),
         escape(&title),
         escape(&title),
         escape(&d.decision),
-        escape(&d.summary)
+        escape(&d.summary),
+        escape(OUTCOMES)
     );
     if !d.at_bound.is_empty() {
         let _ = writeln!(
@@ -398,7 +415,22 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
             um(p.after_rms_m)
         );
     }
-    s.push_str("</tbody></table>\n<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th></tr></thead><tbody>\n");
+    s.push_str("</tbody></table>\n");
+    if let Some(c) = &d.noise_check {
+        s.push_str(&noise_check_html(
+            &format!(
+                "Does {} explain the data to the noise?",
+                d.best_candidate.as_deref().unwrap_or("the best candidate")
+            ),
+            c,
+        ));
+    } else {
+        s.push_str(&noise_check_html(
+            "Does the calibrated baseline explain the data to the noise?",
+            &d.baseline_noise_check,
+        ));
+    }
+    s.push_str("<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th></tr></thead><tbody>\n");
     for c in &d.candidates {
         let params: Vec<String> = c
             .params
@@ -429,6 +461,99 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
 }
 
 /// The work of each stage and its rates as a Markdown table.
+/// What the decisions mean, for the pages (issue 33).
+pub(super) const OUTCOMES: &str = "named: one effect whose model explains every run to the \
+    noise; ambiguous: several such effects the data cannot tell apart; partly_explained: the \
+    best candidate takes part of the gap but leaves a phase beyond the noise, residuals that \
+    are not white, or shrinks the flagged gap less than twice, so nothing is named and \
+    nothing added; none: the calibrated model explains the data already; unexplained: no \
+    candidate takes any of it";
+
+/// The test a name must pass, in Markdown: whether the model (the best candidate's, or
+/// the baseline's) explains every run to the noise, and the cells and whiteness tests that
+/// fail.
+pub(super) fn noise_check_markdown(title: &str, c: &NoiseCheck) -> String {
+    let mut s = format!(
+        "## {title}
+
+Every phase and marker within {} noise floors (whitened RMS, \
+         significant for the phase's size; phases under 10 ms judged with the next) and \
+         white residuals (Ljung–Box after an AR(1) of their own): **{}**.\n\n",
+        c.floors,
+        c.summary()
+    );
+    let failing: Vec<&CellCheck> = c.cells.iter().filter(|x| x.fails).collect();
+    if !failing.is_empty() {
+        s.push_str("| run | phase | marker | from (ms) | to (ms) | plain (floors) | whitened | p |\n|---|---|---|---|---|---|---|---|\n");
+        for x in failing {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {:.1e} |",
+                x.run,
+                x.phase,
+                x.marker,
+                x.t0_s * 1e3,
+                x.t1_s.min(1e3) * 1e3,
+                x.floors,
+                x.whitened_rms,
+                x.p_value
+            );
+        }
+        s.push('\n');
+    }
+    for w in &c.not_white {
+        let _ = writeln!(
+            s,
+            "- not white: `{}` in {} (Ljung–Box Q = {:.0} over {} lags, p = {:.1e})",
+            w.marker, w.run, w.q, w.lags, w.p_value
+        );
+    }
+    s
+}
+
+/// [`noise_check_markdown`] for the HTML page.
+pub(super) fn noise_check_html(title: &str, c: &NoiseCheck) -> String {
+    let mut s = format!(
+        "<h2>{}</h2>\n<p>Every phase and marker within {} noise floors (whitened RMS, \
+         significant for the phase's size; phases under 10 ms judged with the next) and \
+         white residuals (Ljung–Box after an AR(1) of their own): <b>{}</b>.</p>\n",
+        escape(title),
+        c.floors,
+        escape(&c.summary())
+    );
+    let failing: Vec<&CellCheck> = c.cells.iter().filter(|x| x.fails).collect();
+    if !failing.is_empty() {
+        s.push_str("<table><tr><th>run</th><th>phase</th><th>marker</th><th>from (ms)</th><th>to (ms)</th><th>plain (floors)</th><th>whitened</th><th>p</th></tr>\n");
+        for x in failing {
+            let _ = writeln!(
+                s,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}</td><td>{:.1e}</td></tr>",
+                escape(&x.run),
+                escape(&x.phase),
+                escape(&x.marker),
+                x.t0_s * 1e3,
+                x.t1_s.min(1e3) * 1e3,
+                x.floors,
+                x.whitened_rms,
+                x.p_value
+            );
+        }
+        s.push_str("</table>\n");
+    }
+    for w in &c.not_white {
+        let _ = writeln!(
+            s,
+            "<p>Not white: <code>{}</code> in {} (Ljung–Box Q = {:.0} over {} lags, p = {:.1e})</p>",
+            escape(&w.marker),
+            escape(&w.run),
+            w.q,
+            w.lags,
+            w.p_value
+        );
+    }
+    s
+}
+
 pub(super) fn throughput_markdown(stages: &[StageWork]) -> String {
     let mut s = String::from(
         "| stage | wall (s) | fits | evaluations | simulations | fits/s | simulations/s |\n\
