@@ -18,6 +18,9 @@ pub struct EffectParam {
     pub typical: f64,
     /// Whether the fit moves it on a log scale (shape parameters spanning decades).
     pub log_scale: bool,
+    /// Values a screening tries for this shape parameter besides the strength's grid (a
+    /// flexibility's location); empty: its typical value only.
+    pub screen: &'static [f64],
 }
 
 /// An effect of a library.

@@ -411,7 +411,8 @@ pub enum LawSpec {
         /// Damping (N·s/m).
         c: f64,
     },
-    /// Power law with Hunt–Crossley damping `F = k δᵖ (1 + α δ̇)`.
+    /// Power law with Hunt–Crossley damping `F = k δᵖ (1 + (3/2) α δ̇)` (Hunt & Crossley's
+    /// material constant α; `mbs_contact::laws::HuntCrossley`).
     HuntCrossley {
         /// Stiffness (N/mᵖ).
         k: f64,

@@ -126,7 +126,8 @@ fn nothing_hidden_gives_none() {
 }
 
 /// Load friction kept out of the library: its look-alikes must not be named cleanly; the
-/// held-out run at the other amplitude shows it.
+/// held-out run at the other amplitude shows it (`partly_explained`: the best look-alike
+/// takes part of the gap and leaves the rest).
 #[test]
 fn an_effect_outside_the_library_is_not_named() {
     let (d, _) = run(
@@ -137,7 +138,10 @@ fn an_effect_outside_the_library_is_not_named() {
         Some("pivot_viscous,air_drag,pivot_stribeck"),
     );
     assert!(
-        d.decision == "unexplained" || d.decision == "ambiguous",
+        matches!(
+            d.decision.as_str(),
+            "unexplained" | "partly_explained" | "ambiguous"
+        ),
         "{}: {}",
         d.decision,
         d.summary

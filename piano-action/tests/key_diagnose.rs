@@ -194,7 +194,7 @@ fn study_over_seeds() {
                 .is_none_or(|o| o.iter().any(|x| x == e.unwrap_or("none")))
         })
         .collect();
-    let (mut ambiguous, mut unexplained) = (0, 0);
+    let (mut ambiguous, mut unexplained, mut partly) = (0, 0, 0);
     let (mut right, mut wrong, mut total, mut none_ok, mut negatives) = (0, 0, 0, 0, 0);
     // The gap after the check's catch, before and after, of the datasets whose effect
     // shows there (the baseline misses it by 3 noise floors or more): squared sums.
@@ -252,6 +252,7 @@ fn study_over_seeds() {
                     total += 1;
                     ambiguous += usize::from(d.decision == "ambiguous");
                     unexplained += usize::from(d.decision == "unexplained");
+                    partly += usize::from(d.decision == "partly_explained");
                     if named.iter().any(|n| n == id) {
                         right += 1;
                     } else if d.decision == "named" {
@@ -272,8 +273,8 @@ fn study_over_seeds() {
     );
     eprintln!(
         "right (named or in the ambiguity): {right}/{total}; wrong confident name: \
-         {wrong}/{total} (ambiguous {ambiguous}, unexplained {unexplained}); none on \
-         negatives: {none_ok}/{negatives}"
+         {wrong}/{total} (ambiguous {ambiguous}, partly explained {partly}, unexplained \
+         {unexplained}); none on negatives: {none_ok}/{negatives}"
     );
     let post_ratio = (post_before / post_after.max(1e-300)).sqrt();
     eprintln!(

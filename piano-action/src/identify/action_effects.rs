@@ -5,11 +5,11 @@
 //!
 //! | id | transformation | parameters (null) |
 //! |---|---|---|
-//! | `key_flex` | `split_body` of the key 20 mm behind the balance pivot: the back arm (capstan, back-check, back rail) on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
-//! | `shank_flex` | `split_body` of the hammer at the head's root, 110 mm along the shank: the head (crown, tail) on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
+//! | `key_flex` | `split_body` of the key `cut_m` (20 mm typically) behind the balance pivot: the back arm (capstan, back-check, back rail) on a torsion spring | `compliance_rad_n_m` (0), `zeta`, `cut_m` |
+//! | `shank_flex` | `split_body` of the hammer `root_m` along the shank (the head's root, 110 mm, typically): the head (crown, tail) on a torsion spring | `compliance_rad_n_m` (0), `zeta`, `root_m` |
 //! | `backcheck_compliance` | `mount_compliant` of the back-check's face on a wire rooted on the key: a body `backcheck` on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
-//! | `keybed_felt` | `swap_law` of the front-rail punching: its stiffness scaled, its restitution set | `k_scale` (1), `e` |
-//! | `felt_hysteresis` | `swap_law` of the knuckle's felt: its restitution (loading against unloading) shifted | `de` (0) |
+//! | `keybed_felt` | `swap_law` of the front-rail punching: its stiffness scaled, its restitution set, its exponent | `k_scale` (1), `e`, `p` |
+//! | `felt_hysteresis` | `swap_law` of the knuckle's felt: its restitution (loading against unloading) shifted, its exponent | `de` (0), `p` |
 //! | `knuckle_friction` | `swap_friction` of the jack–knuckle contact: its friction coefficient raised | `dmu` (0) |
 //!
 //! A flex's damping is given by its ratio ζ: c = 2 ζ √(k I), I the moving part's inertia
@@ -22,7 +22,10 @@ use mbs_mechanism::{ContactFrictionSpec, Flex, LawSpec, MassProps, Mechanism, Si
 use crate::error::{PianoError, Result};
 use crate::params::ActionParams;
 
-/// The key bends: its back arm on a torsion spring 20 mm behind the balance pivot. Range
+/// The key bends: its back arm on a torsion spring `cut_m` behind the balance pivot (20 mm
+/// typically; anywhere from the balance hole to the back-check, 10–190 mm [D]: a real key
+/// bends where its wood is weakest, and the one hinge stands for its first mode; past the
+/// capstan at 110 mm the capstan stays on the front part). Range
 /// [D] `identification.md` §3.5: a basswood key (EI ≈ 200 N·m²) over its 0.2 m back arm
 /// is about 3 EI/L ≈ 3000 N·m/rad at the rail; the plausible range allows 30 times softer
 /// (a cracked or thin key) and 30 times stiffer. The typical (visible) value, 1e-3
@@ -40,15 +43,28 @@ pub const KEY_FLEX: EffectSpec = EffectSpec {
             range: [1e-5, 1e-2],
             typical: 1e-3,
             log_scale: true,
+            screen: &[],
         },
         ZETA,
+        EffectParam {
+            name: "cut_m",
+            unit: "m",
+            null: None,
+            range: [0.01, 0.19],
+            typical: 0.02,
+            log_scale: false,
+            screen: &[],
+        },
     ],
     confusable_with: &["backcheck_compliance", "keybed_felt", "shank_flex"],
     discriminating_experiment: "track the key's back end (or the capstan) as well as its \
         front: only a bending key moves them apart",
 };
 
-/// The hammer shank bends: the head on a torsion spring at its root. Range [D]: a
+/// The hammer shank bends: the head on a torsion spring `root_m` along the shank (at the
+/// head's root, 110 mm, typically; anywhere from 30 mm, beyond the knuckle, to 115 mm
+/// [D]: the one hinge stands for the shank's first mode, wherever it bends most). Range
+/// [D]: a
 /// hornbeam shank (d ≈ 8 mm, EI ≈ 2 N·m²) is some 40 N·m/rad at the head's root; the
 /// range allows 10 times stiffer and 80 times softer. The typical (visible) value, 0.15
 /// rad/(N·m) (a thin shank, 6 times softer than that estimate), is where the gap after
@@ -65,8 +81,18 @@ pub const SHANK_FLEX: EffectSpec = EffectSpec {
             range: [2.5e-3, 2.0],
             typical: 0.15,
             log_scale: true,
+            screen: &[],
         },
         ZETA,
+        EffectParam {
+            name: "root_m",
+            unit: "m",
+            null: None,
+            range: [0.03, 0.115],
+            typical: 0.11,
+            log_scale: false,
+            screen: &[],
+        },
     ],
     confusable_with: &["backcheck_compliance", "key_flex"],
     discriminating_experiment: "track two points on the hammer, the head and the middle of \
@@ -89,6 +115,7 @@ pub const BACKCHECK_COMPLIANCE: EffectSpec = EffectSpec {
             range: [1e-3, 1.0],
             typical: 0.1,
             log_scale: true,
+            screen: &[],
         },
         ZETA,
     ],
@@ -111,6 +138,7 @@ pub const KEYBED_FELT: EffectSpec = EffectSpec {
             range: [0.05, 20.0],
             typical: 0.5,
             log_scale: true,
+            screen: &[],
         },
         EffectParam {
             name: "e",
@@ -119,7 +147,9 @@ pub const KEYBED_FELT: EffectSpec = EffectSpec {
             range: [0.05, 0.95],
             typical: 0.4,
             log_scale: false,
+            screen: &[],
         },
+        FELT_EXPONENT,
     ],
     confusable_with: &["key_flex"],
     discriminating_experiment: "change the mass on the key: the key bottoms on the punching \
@@ -133,14 +163,18 @@ pub const FELT_HYSTERESIS: EffectSpec = EffectSpec {
     id: "felt_hysteresis",
     summary: "the knuckle's felt loses more (or less) between loading and unloading than \
         the file says",
-    params: &[EffectParam {
-        name: "de",
-        unit: "",
-        null: Some(0.0),
-        range: [-0.38, 0.55],
-        typical: 0.45,
-        log_scale: false,
-    }],
+    params: &[
+        EffectParam {
+            name: "de",
+            unit: "",
+            null: Some(0.0),
+            range: [-0.38, 0.55],
+            typical: 0.45,
+            log_scale: false,
+            screen: &[],
+        },
+        FELT_EXPONENT,
+    ],
     confusable_with: &["knuckle_friction"],
     discriminating_experiment: "drop the mass from two heights: felt hysteresis grows with \
         the knuckle's compression, friction with the jack's slide",
@@ -158,11 +192,35 @@ pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
         range: [0.0, 0.6],
         typical: 0.15,
         log_scale: false,
+        screen: &[],
     }],
     confusable_with: &["felt_hysteresis"],
     discriminating_experiment: "drop the mass from two heights: friction follows the jack's \
         slide under the knuckle, felt hysteresis its compression",
 };
+
+/// A felt's force-law exponent [S] `identification.md` §2 (power laws F = Q₀ xᵖ with p ≈
+/// 2–5 from hammer-felt experiments, Boutillon 1988): from 1.5 (a thin, hard punching) to
+/// 4; the file's action felts are 2. Free in the refit from the file's 2 (screening it at
+/// 3 as well sent the refit of the library's own bending key into another basin: its
+/// location and exponent are refitted, not screened, for now).
+const FELT_EXPONENT: EffectParam = EffectParam {
+    name: "p",
+    unit: "",
+    null: None,
+    range: [1.5, 4.0],
+    typical: 2.0,
+    log_scale: false,
+    screen: &[],
+};
+
+/// The front-rail punching's working compression (m) [D]: the 1 kg mass on the key front
+/// presses the file's punching (k 5e7 N/m², p 2) by √(m g / k) ≈ 0.45 mm; a felt of
+/// another exponent keeps the force there.
+const KEYBED_WORKING_M: f64 = 5e-4;
+/// The knuckle felt's working compression (m) [D]: the jack lifting the hammer (a few
+/// newtons on the file's k 5e7 N/m², p 2) presses it by about 0.2–0.3 mm.
+const KNUCKLE_WORKING_M: f64 = 2e-4;
 
 /// A flex's damping ratio [D]: wood and felt joints ring with ζ of a few per cent.
 const ZETA: EffectParam = EffectParam {
@@ -172,6 +230,7 @@ const ZETA: EffectParam = EffectParam {
     range: [0.005, 0.5],
     typical: 0.05,
     log_scale: true,
+    screen: &[],
 };
 
 /// The action family, in the order a diagnosis tries them.
@@ -243,14 +302,16 @@ impl ActionEffect {
     }
 }
 
-/// Where the key bends [D]: 20 mm behind the balance pivot (the balance hole's wood stays
-/// whole), the cut across the key.
-const KEY_CUT_M: [f64; 2] = [0.02, 0.0];
-/// The back arm's share of the key's mass [D]: the front arm carries the lead weights.
+/// The back arm's share of the key's mass with the cut 20 mm behind the pivot [D]: the
+/// front arm carries the lead weights; a cut further back takes a share in proportion to
+/// the arm's length (the stick's wood is even).
 const KEY_BACK_MASS_SHARE: f64 = 0.27;
+/// The shank's mass per length (kg/m) [D]: hornbeam, 8 mm across (about 700 kg/m³ over
+/// 50 mm²: 0.035 kg/m), less for its taper: 0.025.
+const SHANK_KG_M: f64 = 0.025;
 /// Where the shank meets the head, along the shank from the flange pin (m) [D]: the
 /// moulding spans 115–140 mm around the 132 mm strike point.
-const HEAD_ROOT_M: [f64; 2] = [0.11, 0.0];
+const HEAD_ROOT_M: f64 = 0.11;
 /// The head's share of the hammer's mass [D]: felt and moulding some 8 g of the 11.74 g.
 const HEAD_MASS_SHARE: f64 = 0.68;
 /// The head's centre of mass in the hammer frame (m) [D]: the moulding's middle.
@@ -273,18 +334,29 @@ struct Cut {
     new_body: &'static str,
 }
 
-/// The cut of `key_flex` or `shank_flex`.
-fn cut_of(id: &str) -> Option<Cut> {
-    match id {
+/// The cut of `key_flex` or `shank_flex` at `values` (its location parameter; the
+/// typical one when the values do not hold it).
+fn cut_of(spec: &EffectSpec, values: &[f64]) -> Option<Cut> {
+    let at = |name: &str| {
+        let i = spec.params.iter().position(|p| p.name == name)?;
+        Some(
+            values
+                .get(i)
+                .copied()
+                .filter(|v| v.is_finite())
+                .unwrap_or(spec.params[i].typical),
+        )
+    };
+    match spec.id {
         "key_flex" => Some(Cut {
             body: "key",
-            at: KEY_CUT_M,
+            at: [at("cut_m")?, 0.0],
             along: [1.0, 0.0],
             new_body: "key_back_arm",
         }),
         "shank_flex" => Some(Cut {
             body: "hammer",
-            at: HEAD_ROOT_M,
+            at: [at("root_m")?, 0.0],
             along: [1.0, 0.0],
             new_body: "hammer_head",
         }),
@@ -293,10 +365,28 @@ fn cut_of(id: &str) -> Option<Cut> {
 }
 
 /// The body and local point (m) that a marker given on `body` at `local_m` (in the
-/// parameter file's body frames) rides on once `effect_id` is added: a split moves the
+/// parameter file's body frames) rides on once `effect` is added: a split moves the
 /// points beyond its cut onto the new body, in its frame.
-pub fn marker_body(effect_id: Option<&str>, body: &str, local_m: [f64; 2]) -> (String, [f64; 2]) {
-    if let Some(cut) = effect_id.and_then(cut_of)
+pub fn marker_body(
+    effect: Option<&ActionEffect>,
+    body: &str,
+    local_m: [f64; 2],
+) -> (String, [f64; 2]) {
+    match effect {
+        Some(e) => marker_body_at(e.spec, &e.values, body, local_m),
+        None => (body.to_string(), local_m),
+    }
+}
+
+/// [`marker_body`] for effect `spec` at `values` (its typical location when they do not
+/// hold one).
+pub fn marker_body_at(
+    spec: &EffectSpec,
+    values: &[f64],
+    body: &str,
+    local_m: [f64; 2],
+) -> (String, [f64; 2]) {
+    if let Some(cut) = cut_of(spec, values)
         && cut.body == body
     {
         let d = [local_m[0] - cut.at[0], local_m[1] - cut.at[1]];
@@ -363,24 +453,37 @@ pub fn apply(
             if c <= 0.0 {
                 return Err(bad(spec.id, format!("compliance {c} must be positive")));
             }
-            let cut = cut_of(spec.id).ok_or_else(|| bad(spec.id, "no cut".into()))?;
+            let cut = cut_of(spec, values).ok_or_else(|| bad(spec.id, "no cut".into()))?;
             let whole = MassProps::of(body(cut.body)?);
             let distal = if spec.id == "key_flex" {
-                // The back arm: a share of the key's mass as a uniform bar from the cut
-                // to the back rail's pad.
+                // The back arm: the stick's share of the key's mass as a uniform bar from
+                // the cut to the back rail's pad, in proportion to its length.
                 let back = (params.key.back_pad_mm[0] - params.key.pivot_mm[0]) * 1e-3;
                 let length = back + 0.01 - cut.at[0];
-                let mass = KEY_BACK_MASS_SHARE * whole.mass;
+                let typical = back + 0.01 - 0.02;
+                let mass = KEY_BACK_MASS_SHARE * whole.mass * length / typical;
                 MassProps {
                     mass,
                     com: [cut.at[0] + 0.5 * length, whole.com[1]],
                     inertia: mass * length * length / 12.0,
                 }
             } else {
-                MassProps {
+                let head = MassProps {
                     mass: HEAD_MASS_SHARE * whole.mass,
                     com: HEAD_COM_M,
                     inertia: HEAD_INERTIA_KG_M2,
+                };
+                // A cut inside the shank takes the shank's piece beyond it as a rod.
+                let piece = (HEAD_ROOT_M - cut.at[0]).max(0.0);
+                if piece > 0.0 {
+                    let m = SHANK_KG_M * piece;
+                    head.plus(&MassProps {
+                        mass: m,
+                        com: [cut.at[0] + 0.5 * piece, 0.0],
+                        inertia: m * piece * piece / 12.0,
+                    })
+                } else {
+                    head
                 }
             };
             let r2 = (distal.com[0] - cut.at[0]).powi(2) + (distal.com[1] - cut.at[1]).powi(2);
@@ -439,17 +542,26 @@ pub fn apply(
                     format!("contact '{contact}' has no felt law to change"),
                 ));
             };
+            // Another exponent keeps the force at the felt's working compression: k δᵖ
+            // = k' δ^p' there.
+            let exponent = value(spec, values, "p")?;
+            let reference = if spec.id == "keybed_felt" {
+                KEYBED_WORKING_M
+            } else {
+                KNUCKLE_WORKING_M
+            };
+            let k = k * reference.powf(p - exponent);
             let law = if spec.id == "keybed_felt" {
                 LawSpec::Felt {
                     k: k * value(spec, values, "k_scale")?,
-                    p,
+                    p: exponent,
                     e: value(spec, values, "e")?.clamp(0.02, 1.0),
                     smoothing,
                 }
             } else {
                 LawSpec::Felt {
                     k,
-                    p,
+                    p: exponent,
                     e: (e + value(spec, values, "de")?).clamp(0.02, 1.0),
                     smoothing,
                 }
@@ -528,18 +640,34 @@ mod tests {
 
     #[test]
     fn markers_beyond_a_cut_ride_the_new_body() {
-        let (b, p) = marker_body(Some("shank_flex"), "hammer", [0.132, 0.0356]);
+        let typical =
+            |spec: &EffectSpec| -> Vec<f64> { spec.params.iter().map(|p| p.typical).collect() };
+        let (b, p) = marker_body_at(
+            &SHANK_FLEX,
+            &typical(&SHANK_FLEX),
+            "hammer",
+            [0.132, 0.0356],
+        );
         assert_eq!(b, "hammer_head");
         assert!((p[0] - 0.022).abs() < 1e-12 && (p[1] - 0.0356).abs() < 1e-12);
         assert_eq!(
-            marker_body(Some("shank_flex"), "hammer", [0.06, 0.01]).0,
+            marker_body_at(&SHANK_FLEX, &typical(&SHANK_FLEX), "hammer", [0.06, 0.01]).0,
             "hammer"
         );
+        // Bent at 45 mm, the shank's middle rides the head's part.
+        let mut mid = typical(&SHANK_FLEX);
+        mid[2] = 0.045;
+        let (b, p) = marker_body_at(&SHANK_FLEX, &mid, "hammer", [0.06, 0.01]);
+        assert_eq!(b, "hammer_head");
+        assert!((p[0] - 0.015).abs() < 1e-12);
         assert_eq!(
-            marker_body(Some("key_flex"), "key", [0.22, 0.0]).0,
+            marker_body_at(&KEY_FLEX, &typical(&KEY_FLEX), "key", [0.22, 0.0]).0,
             "key_back_arm"
         );
-        assert_eq!(marker_body(Some("key_flex"), "key", [-0.2, 0.0]).0, "key");
+        assert_eq!(
+            marker_body_at(&KEY_FLEX, &typical(&KEY_FLEX), "key", [-0.2, 0.0]).0,
+            "key"
+        );
         assert_eq!(marker_body(None, "key", [0.22, 0.0]).0, "key");
     }
 }

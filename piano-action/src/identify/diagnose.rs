@@ -700,6 +700,7 @@ pub fn diagnose(
                             time_s: r.times[o.frame],
                             standardized: s,
                             whitened: w,
+                            segment_start: o.segment_start,
                         })
                         .collect(),
                 }
@@ -916,15 +917,35 @@ pub fn diagnose(
     };
     let best = best_of(&verdict);
     let best_check = best.map(|t| noise_check(&t.fit_raw, &t.heldout_raw));
-    let shrink = best.map(|t| flagged_before / flagged_rms(&t.fit_raw, &t.heldout_raw).max(1e-300));
+    let shrink = best.map(|t| {
+        super::key_diagnose::excess_shrink(
+            flagged_before,
+            flagged_rms(&t.fit_raw, &t.heldout_raw),
+            sigma,
+        )
+    });
     let explains = best_check.as_ref().is_some_and(|c| c.explained)
         && shrink.is_some_and(|x| x >= super::key_diagnose::SHRINK_MIN);
     let verdict = match verdict {
+        // A baseline that explains the data already needs nothing.
+        Verdict::Named(_) | Verdict::Ambiguous(..) | Verdict::Partial(..)
+            if base_check.explained && !explains =>
+        {
+            Verdict::None
+        }
         Verdict::Named(i) | Verdict::Ambiguous(i, _) if !explains => {
             Verdict::Partial(i, best_check.as_ref().map_or(f64::NAN, worst_floors))
         }
+        Verdict::None | Verdict::Unexplained => {
+            if base_check.explained {
+                Verdict::None
+            } else {
+                Verdict::Unexplained
+            }
+        }
         v => v,
     };
+    let best = best_of(&verdict);
     let mut ambiguous_with = Vec::new();
     let mut separating = None;
     let chosen = match &verdict {
@@ -1084,8 +1105,8 @@ pub fn diagnose(
     throughput.push(clock.total());
     Ok(Diagnosis {
         best_candidate: best.map(|t| t.spec.id.to_string()),
-        flagged_shrink: shrink,
-        noise_check: best_check,
+        flagged_shrink: best.and(shrink),
+        noise_check: best.and(best_check),
         baseline_noise_check: base_check,
         decision,
         summary,
@@ -1131,14 +1152,16 @@ pub enum Verdict {
     Named(usize),
     /// The best and the others within [`AMBIGUITY_BIC`] of it.
     Ambiguous(usize, Vec<usize>),
-    /// The best explains part of the gap only: the held-out one keeps this many noise
-    /// floors (a look-alike of something outside the library), or its model leaves a
-    /// phase or the residuals' whiteness beyond the noise, or it shrinks the flagged gap
-    /// less than twice. Reported as `partly_explained`.
+    /// The best explains part of the gap only: the held-out one keeps a gap (this many
+    /// noise floors) of a look-alike of something outside the library, or its model leaves
+    /// a phase (the worst this many floors) or the residuals' whiteness beyond the noise,
+    /// or it shrinks the flagged gap less than twice. Reported as `partly_explained`.
     Partial(usize, f64),
-    /// Nothing kept, and the baseline is within [`EXPLAINED_FLOORS`] everywhere.
+    /// Nothing kept (or nothing needed), and the baseline explains the data to the noise
+    /// (within [`EXPLAINED_FLOORS`] everywhere in [`decide`]; the noise check of
+    /// `mbs_identify::explain` in the diagnosis).
     None,
-    /// Nothing kept, and the baseline is not at the noise floor.
+    /// Nothing kept, and the baseline does not explain the data.
     Unexplained,
 }
 

@@ -35,6 +35,7 @@ pub const PIVOT_VISCOUS: EffectSpec = EffectSpec {
         range: [0.0, 5e-4],
         typical: 4e-5,
         log_scale: false,
+        screen: &[],
     }],
     confusable_with: &["air_drag"],
     discriminating_experiment: "releases from two or more amplitudes: viscous decay is the same \
@@ -53,6 +54,7 @@ pub const AIR_DRAG: EffectSpec = EffectSpec {
         range: [0.0, 2e-5],
         typical: 3e-6,
         log_scale: false,
+        screen: &[],
     }],
     confusable_with: &["pivot_viscous", "pivot_load_friction"],
     discriminating_experiment: "releases from two or more amplitudes: drag grows with the \
@@ -72,6 +74,7 @@ pub const PIVOT_STRIBECK: EffectSpec = EffectSpec {
             range: [0.0, 2e-3],
             typical: 5e-4,
             log_scale: false,
+            screen: &[],
         },
         EffectParam {
             name: "ws_rad_s",
@@ -80,6 +83,7 @@ pub const PIVOT_STRIBECK: EffectSpec = EffectSpec {
             range: [0.02, 5.0],
             typical: 0.5,
             log_scale: true,
+            screen: &[],
         },
     ],
     confusable_with: &["pivot_load_friction"],
@@ -99,6 +103,7 @@ pub const PIVOT_LOAD_FRICTION: EffectSpec = EffectSpec {
         range: [0.0, 5e-3],
         typical: 2.5e-3,
         log_scale: false,
+        screen: &[],
     }],
     confusable_with: &["air_drag"],
     discriminating_experiment: "releases from two or more amplitudes, or with a weight added \

@@ -27,7 +27,11 @@
 //! the pendulum's rules (whitened BIC, effect size, identifiability and plausibility) with
 //! a held-out drop that may not get worse (see [`HELDOUT_WORSEN_MAX`]), and one more: two
 //! confusable effects that the tracked markers cannot separate are reported as ambiguous,
-//! whatever their BIC.
+//! whatever their BIC. Last, no name without the data explained (issue 33): the chosen
+//! effect's model must bring every run, fitted and held out, to the noise (each phase and
+//! marker, and the residuals' whiteness: `mbs_identify::explain`) and shrink the flagged
+//! gap at least twice over the noise ([`SHRINK_MIN`]); short of that the decision is
+//! `partly_explained`, which names nothing and adds nothing.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -36,7 +40,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use mbs_identify::explain::{
-    NoiseCheck, NoiseCheckOptions, Residual, RunResiduals, Window, check_noise,
+    NoiseCheck, NoiseCheckOptions, Residual, RunResiduals, Window, check_noise, merged,
 };
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
@@ -44,11 +48,10 @@ use mbs_identify::work::{StageClock, StageWork, WorkCounter};
 use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
-use super::action_effects::{ACTION_EFFECTS, ActionEffect, marker_body};
+use super::action_effects::{ACTION_EFFECTS, ActionEffect, action_effect_spec, marker_body_at};
 use super::data_check::{DataCheck, Run, dataset_error, noise_floor, observations};
 use super::diagnose::{
-    AMBIGUITY_BIC, DELTA_BIC_MAX, EFFECT_SIZE_MIN, EXPLAINED_FLOORS, IDENTIFIABLE_REL_SD,
-    NamedEffect, Progress,
+    AMBIGUITY_BIC, DELTA_BIC_MAX, EFFECT_SIZE_MIN, IDENTIFIABLE_REL_SD, NamedEffect, Progress,
 };
 use super::key_drive::{EXPERIMENT, Phase, marker_tracks_of, sequence, simulate_effect};
 use super::recent::{Recent, RecentKey};
@@ -957,6 +960,15 @@ impl<'a> Problem<'a> {
     }
 }
 
+/// How many times a candidate shrinks a gap over the noise: the baseline's RMS gap
+/// `before` and the candidate's `after` (m) each less the noise floor `sigma` in
+/// quadrature, so that a gap brought to the noise counts as gone (the factor is then
+/// large) and one already near the noise cannot be shrunk much.
+pub(super) fn excess_shrink(before: f64, after: f64, sigma: f64) -> f64 {
+    let excess = |g: f64| (g * g - sigma * sigma).max(0.0).sqrt();
+    excess(before) / excess(after).max(0.05 * sigma)
+}
+
 /// Whether the model whose every run is `eval` (raw residuals and simulation, laid out as
 /// the problem's runs) explains the data to the noise: each run's residuals standardized
 /// by the noise floor and whitened with its correlation, cut by the model's own phases.
@@ -990,6 +1002,7 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
                         time_s: r.times[o.frame],
                         standardized: s,
                         whitened: w,
+                        segment_start: o.segment_start,
                     })
                     .collect(),
             }
@@ -1027,8 +1040,13 @@ trait IdBounds {
 
 impl IdBounds for mbs_identify::EffectParam {
     fn id_bounds(&self) -> Option<(f64, f64)> {
-        // A friction coefficient cannot go below the file's by more than it has.
-        (self.name == "dmu").then_some((-0.1, self.range[1] * 1.25))
+        match self.name {
+            // A friction coefficient cannot go below the file's by more than it has.
+            "dmu" => Some((-0.1, self.range[1] * 1.25)),
+            // A flexibility's location stays on its part.
+            "cut_m" | "root_m" => Some((self.range[0], self.range[1])),
+            _ => None,
+        }
     }
 }
 
@@ -1079,7 +1097,8 @@ fn moving(id: &str) -> bool {
 /// bending shank). Empty when no tracked marker can.
 pub fn separating_markers(a: &str, b: &str, dataset: &Dataset) -> Vec<usize> {
     let moved = |id: &str, m: &mbs_identify::MarkerSpec| {
-        marker_body(Some(id), &m.body, m.local_m).0 != m.body
+        action_effect_spec(id)
+            .is_some_and(|spec| marker_body_at(spec, &[], &m.body, m.local_m).0 != m.body)
     };
     let shows = |id: &str, m: &mbs_identify::MarkerSpec| match id {
         "backcheck_compliance" => m.body == "backcheck",
@@ -1128,12 +1147,14 @@ pub const SEPARATION_BIC: f64 = 10.0;
 /// values.
 pub const SCREEN_POINTS: usize = 6;
 
-/// The screening grid of `spec` (see [`SCREEN_POINTS`]), the null left out.
+/// The screening grid of `spec` (see [`SCREEN_POINTS`]), the null left out: the
+/// strength over its range times every value a shape parameter asks to be screened at
+/// (a flexibility's location), the others at their typical values.
 fn grid_of(spec: &EffectSpec) -> Vec<Vec<f64>> {
     let typical: Vec<f64> = spec.params.iter().map(|p| p.typical).collect();
     let p = &spec.params[0];
     let n = SCREEN_POINTS;
-    (0..n)
+    let mut points: Vec<Vec<f64>> = (0..n)
         .map(|i| {
             let u = i as f64 / (n - 1) as f64;
             let v = if p.log_scale {
@@ -1146,11 +1167,29 @@ fn grid_of(spec: &EffectSpec) -> Vec<Vec<f64>> {
             values
         })
         .filter(|v| Some(v[0]) != p.null)
-        .collect()
+        .collect();
+    for (j, q) in spec.params.iter().enumerate().skip(1) {
+        if q.screen.is_empty() {
+            continue;
+        }
+        points = q
+            .screen
+            .iter()
+            .flat_map(|s| {
+                points.iter().map(move |v| {
+                    let mut v = v.clone();
+                    v[j] = *s;
+                    v
+                })
+            })
+            .collect();
+    }
+    points
 }
 
-/// The midpoints between point `i` of the screening `grid` and its neighbours, in the
-/// strength's own scale (log or linear).
+/// The midpoints between the strength of point `i` of the screening `grid` and its
+/// neighbours' among the points that share its other values, in the strength's own scale
+/// (log or linear).
 fn refine_grid(spec: &EffectSpec, grid: &[Vec<f64>], i: usize) -> Vec<Vec<f64>> {
     let p = &spec.params[0];
     let mid = |a: f64, b: f64| {
@@ -1160,12 +1199,19 @@ fn refine_grid(spec: &EffectSpec, grid: &[Vec<f64>], i: usize) -> Vec<Vec<f64>> 
             0.5 * (a + b)
         }
     };
-    [i.checked_sub(1), (i + 1 < grid.len()).then_some(i + 1)]
+    let mut line: Vec<f64> = grid
+        .iter()
+        .filter(|v| v[1..] == grid[i][1..])
+        .map(|v| v[0])
+        .collect();
+    line.sort_by(f64::total_cmp);
+    let k = line.iter().position(|&v| v == grid[i][0]).unwrap_or(0);
+    [k.checked_sub(1), (k + 1 < line.len()).then_some(k + 1)]
         .into_iter()
         .flatten()
         .map(|j| {
             let mut v = grid[i].clone();
-            v[0] = mid(grid[i][0], grid[j][0]);
+            v[0] = mid(grid[i][0], line[j]);
             v
         })
         .collect()
@@ -1745,9 +1791,35 @@ pub fn diagnose_key_drive(
     // leaves (issue 33).
     let base_check = noise_check_of(&problem, &base_eval);
     let best_check = best.and_then(|b| tried[b].eval.as_ref().map(|e| noise_check_of(&problem, e)));
-    let shrink = best.map(|b| flagged_before / tried[b].candidate.flagged_rms_m.max(1e-300));
+    // The shrink over the flagged phase judged as the noise check judges it: with the
+    // phases after it when it lasts under 10 ms (a 1-frame free flight is no measure).
+    let flag_window = {
+        let windows: Vec<Window> = base_phases
+            .iter()
+            .map(|p| Window {
+                name: p.name.to_string(),
+                t0_s: p.from_s,
+                t1_s: p.to_s,
+            })
+            .collect();
+        let mid = 0.5
+            * (flag_phase.from_s + flag_phase.to_s.min(r0.times.last().copied().unwrap_or(0.0)));
+        merged(&windows, NoiseCheckOptions::default().min_cell_s)
+            .into_iter()
+            .find(|w| w.t0_s <= mid && mid < w.t1_s)
+            .map_or((flag_phase.from_s, flag_phase.to_s), |w| (w.t0_s, w.t1_s))
+    };
+    let shrink = best.map(|b| {
+        excess_shrink(
+            window_rms(r0, &base_eval[f0].0, flag_window.0, flag_window.1, None),
+            window_rms(r0, &tried[b].fit_res[0], flag_window.0, flag_window.1, None),
+            sigma,
+        )
+    });
     let explains =
         best_check.as_ref().is_some_and(|c| c.explained) && shrink.is_some_and(|x| x >= SHRINK_MIN);
+    // A baseline that explains the data already needs nothing, whatever a candidate adds.
+    let best = best.filter(|_| !base_check.explained || explains);
     let (decision, summary) = match best {
         Some(b) if !explains => {
             let check = best_check.as_ref();
@@ -1764,12 +1836,16 @@ pub fn diagnose_key_drive(
             (
                 "partly_explained".to_string(),
                 format!(
-                    "{} takes {:.0} % of the gap in {} ({:.0} → {:.0} µm), but {}{}",
+                    "{} brings the gap at {:.0}–{:.0} ms (the flagged {} and what follows it \
+                     within 10 ms) from {:.0} to {:.0} µm ({x:.1}× over the noise floor's \
+                     {:.0} µm), but {}{}",
                     tried[b].spec.id,
-                    100.0 * (1.0 - (1.0 / (x * x)).min(1.0)),
+                    flag_window.0 * 1e3,
+                    flag_window.1.min(r0.times.last().copied().unwrap_or(0.0)) * 1e3,
                     flag_phase.name,
-                    flagged_before * 1e6,
-                    tried[b].candidate.flagged_rms_m * 1e6,
+                    window_rms(r0, &base_eval[f0].0, flag_window.0, flag_window.1, None) * 1e6,
+                    window_rms(r0, &tried[b].fit_res[0], flag_window.0, flag_window.1, None) * 1e6,
+                    sigma * 1e6,
                     left.join("; "),
                     if ambiguous_with.is_empty() {
                         String::new()
@@ -1810,11 +1886,12 @@ pub fn diagnose_key_drive(
                     .collect::<String>()
             ),
         ),
-        None if base_worst_floors <= EXPLAINED_FLOORS => (
+        None if base_check.explained => (
             "none".to_string(),
             format!(
-                "the calibrated baseline explains the data to the noise floor (worst phase \
-                 {base_worst_floors:.2} floors)"
+                "the calibrated baseline explains the data to the noise (worst phase \
+                 {base_worst_floors:.2} floors, whitened residuals within {} floors and white)",
+                base_check.floors
             ),
         ),
         None => (
@@ -1829,6 +1906,11 @@ pub fn diagnose_key_drive(
         ),
     };
     let chosen = best.filter(|_| decision == "named" || decision == "ambiguous");
+    // Only an ambiguity lists the effects it cannot separate (a partial explanation's
+    // rivals are in its summary).
+    if decision != "ambiguous" {
+        ambiguous_with.clear();
+    }
     // The model the report compares with the baseline: the chosen one, or the best
     // candidate when it explains only part of the gap (shown, never added).
     let shown = best.filter(|_| decision != "unexplained" && decision != "none");

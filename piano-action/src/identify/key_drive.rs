@@ -265,7 +265,7 @@ pub(super) fn marker_tracks_of(
     let points: Vec<_> = markers
         .iter()
         .map(|m| {
-            let (body, local) = marker_body(effect.map(|e| e.spec.id), &m.body, m.local_m);
+            let (body, local) = marker_body(effect, &m.body, m.local_m);
             let frame = model.frame_id(&body)?;
             Ok(mbs_core::frame_point(model, frame, local))
         })

@@ -1,5 +1,5 @@
 // The key-drive diagnosis's replay: the action drawn to scale as the baseline (grey) and
-// the corrected model (blue) move it, the tracked markers over it (red: measured; crosses:
+// the corrected model (blue; orange: the best candidate of a partial explanation) move it, the tracked markers over it (red: measured; crosses:
 // the model's), the gap between them magnified. REPLAY is written by the report.
 (function () {
   const R = REPLAY;

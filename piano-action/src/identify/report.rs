@@ -462,12 +462,14 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
 
 /// The work of each stage and its rates as a Markdown table.
 /// What the decisions mean, for the pages (issue 33).
-pub(super) const OUTCOMES: &str = "named: one effect whose model explains every run to the \
-    noise; ambiguous: several such effects the data cannot tell apart; partly_explained: the \
-    best candidate takes part of the gap but leaves a phase beyond the noise, residuals that \
-    are not white, or shrinks the flagged gap less than twice, so nothing is named and \
-    nothing added; none: the calibrated model explains the data already; unexplained: no \
-    candidate takes any of it";
+pub(super) const OUTCOMES: &str = "named: one effect passes the selection rules, its model \
+    explains every run, fitted and held out, to the noise, and it shrinks the flagged gap at \
+    least twice over the noise; ambiguous: several such effects the data cannot tell apart; \
+    partly_explained: the best candidate passes the selection rules but leaves a phase \
+    beyond the noise or residuals that are not white, or shrinks the flagged gap less than \
+    twice, so nothing is named and nothing added; none: the calibrated model explains the \
+    data to the noise already; unexplained: it does not, and no candidate passes the \
+    selection rules";
 
 /// The test a name must pass, in Markdown: whether the model (the best candidate's, or
 /// the baseline's) explains every run to the noise, and the cells and whiteness tests that
@@ -554,6 +556,7 @@ pub(super) fn noise_check_html(title: &str, c: &NoiseCheck) -> String {
     s
 }
 
+/// The throughput table of a diagnosis's stages, in Markdown.
 pub(super) fn throughput_markdown(stages: &[StageWork]) -> String {
     let mut s = String::from(
         "| stage | wall (s) | fits | evaluations | simulations | fits/s | simulations/s |\n\

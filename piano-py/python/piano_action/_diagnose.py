@@ -20,10 +20,11 @@ def diagnose(dataset: PathLike, out: PathLike, params: Optional[_core.Params] = 
              force: bool = False) -> Dict[str, Any]:
     """Diagnoses the dataset in the folder ``dataset`` as ``piano diagnose`` does and
     returns its report (``report.json``, which it writes into ``out`` with ``report.md``
-    and ``report.html``): the decision (``named``, ``ambiguous``, ``none`` or
-    ``unexplained``), the gap before and after, the candidates and the calibrated values.
+    and ``report.html``): the decision (``named``, ``ambiguous``, ``partly_explained``,
+    ``none`` or ``unexplained``), the gap before and after, the noise check a name must
+    pass, the candidates and the calibrated values.
     The key ``"written"`` lists the files written, and ``"params_refused"`` says why a
-    ``write_params`` file was not written (a model that does not explain the data, a value
+    ``write_params`` file was not written (a model that does not explain the data or explains it only in part, a value
     at the edge of its search range), when it was not. ``library`` names the effects to try
     (comma-separated ids, all by default); ``write_params`` asks for the corrected
     parameter file (swing tests only); ``out`` is not replaced unless ``force``."""
