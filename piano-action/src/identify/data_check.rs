@@ -369,3 +369,35 @@ impl DataCheck {
         }
     }
 }
+
+/// Run `r`'s raw residuals `raw` (measured − model, m, aligned with its observations)
+/// standardized by the noise floor `sigma`, whitened with the noise's correlation `rho`
+/// in the stretches the observations make, and cut by `phases`: what
+/// `mbs_identify::explain::check_noise` judges.
+pub(super) fn run_residuals(
+    r: &Run,
+    raw: &[f64],
+    sigma: f64,
+    rho: f64,
+    phases: Vec<mbs_identify::explain::Window>,
+) -> mbs_identify::explain::RunResiduals {
+    let standardized: Vec<f64> = raw.iter().map(|e| e / sigma).collect();
+    let starts: Vec<bool> = r.obs.iter().map(|o| o.segment_start).collect();
+    let whitened = noise::whiten(&standardized, &starts, rho);
+    mbs_identify::explain::RunResiduals {
+        run: r.id.clone(),
+        phases,
+        residuals: r
+            .obs
+            .iter()
+            .zip(standardized.iter().zip(&whitened))
+            .map(|(o, (&s, &w))| mbs_identify::explain::Residual {
+                marker: o.marker,
+                time_s: r.times[o.frame],
+                standardized: s,
+                whitened: w,
+                segment_start: o.segment_start,
+            })
+            .collect(),
+    }
+}

@@ -15,9 +15,7 @@ use std::collections::BTreeMap;
 
 use rayon::prelude::*;
 
-use mbs_identify::explain::{
-    NoiseCheck, NoiseCheckOptions, Residual, RunResiduals, Window, check_noise,
-};
+use mbs_identify::explain::{NoiseCheck, NoiseCheckOptions, RunResiduals, Window, check_noise};
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
 use mbs_identify::work::{StageClock, StageWork, WorkCounter};
@@ -25,7 +23,7 @@ use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
 pub use super::data_check::{DataCheck, RunCheck, dataset_error};
-use super::data_check::{Run, prepare};
+use super::data_check::{Run, prepare, run_residuals};
 use super::effects::{EffectEntry, FlangeEffects, HAMMER_FLANGE, PENDULUM_EFFECTS};
 use super::swing_model::SwingModel;
 use crate::error::{PianoError, Result};
@@ -676,34 +674,17 @@ pub fn diagnose(
             .iter()
             .enumerate()
             .map(|(i, r)| {
+                let phases = windows
+                    .iter()
+                    .filter(|w| w.run == i)
+                    .map(|w| Window {
+                        name: w.name.clone(),
+                        t0_s: w.t0,
+                        t1_s: w.t1,
+                    })
+                    .collect();
                 let raw = residuals_of(i, fit, held);
-                let standardized: Vec<f64> = raw.iter().map(|e| e / sigma).collect();
-                let starts: Vec<bool> = r.obs.iter().map(|o| o.segment_start).collect();
-                let whitened = noise::whiten(&standardized, &starts, problem.noise.rho);
-                RunResiduals {
-                    run: r.id.clone(),
-                    phases: windows
-                        .iter()
-                        .filter(|w| w.run == i)
-                        .map(|w| Window {
-                            name: w.name.clone(),
-                            t0_s: w.t0,
-                            t1_s: w.t1,
-                        })
-                        .collect(),
-                    residuals: r
-                        .obs
-                        .iter()
-                        .zip(standardized.iter().zip(&whitened))
-                        .map(|(o, (&s, &w))| Residual {
-                            marker: o.marker,
-                            time_s: r.times[o.frame],
-                            standardized: s,
-                            whitened: w,
-                            segment_start: o.segment_start,
-                        })
-                        .collect(),
-                }
+                run_residuals(r, &raw, sigma, problem.noise.rho, phases)
             })
             .collect();
         let names: Vec<String> = dataset.markers.iter().map(|m| m.name.clone()).collect();

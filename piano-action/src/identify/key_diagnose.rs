@@ -40,7 +40,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use mbs_identify::explain::{
-    NoiseCheck, NoiseCheckOptions, Residual, RunResiduals, Window, check_noise, merged,
+    NoiseCheck, NoiseCheckOptions, RunResiduals, Window, check_noise, merged,
 };
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
@@ -49,7 +49,7 @@ use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
 use super::action_effects::{ACTION_EFFECTS, ActionEffect, action_effect_spec, marker_body_at};
-use super::data_check::{DataCheck, Run, dataset_error, noise_floor, observations};
+use super::data_check::{DataCheck, Run, dataset_error, noise_floor, observations, run_residuals};
 use super::diagnose::{
     AMBIGUITY_BIC, DELTA_BIC_MAX, EFFECT_SIZE_MIN, IDENTIFIABLE_REL_SD, NamedEffect, Progress,
 };
@@ -979,33 +979,16 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
         .iter()
         .zip(eval)
         .map(|(r, (raw, sim))| {
-            let standardized: Vec<f64> = raw.iter().map(|e| e / sigma).collect();
-            let starts: Vec<bool> = r.obs.iter().map(|o| o.segment_start).collect();
-            let whitened = noise::whiten(&standardized, &starts, rho);
-            RunResiduals {
-                run: r.id.clone(),
-                phases: sim
-                    .phases
-                    .iter()
-                    .map(|p| Window {
-                        name: p.name.to_string(),
-                        t0_s: p.from_s,
-                        t1_s: p.to_s,
-                    })
-                    .collect(),
-                residuals: r
-                    .obs
-                    .iter()
-                    .zip(standardized.iter().zip(&whitened))
-                    .map(|(o, (&s, &w))| Residual {
-                        marker: o.marker,
-                        time_s: r.times[o.frame],
-                        standardized: s,
-                        whitened: w,
-                        segment_start: o.segment_start,
-                    })
-                    .collect(),
-            }
+            let phases = sim
+                .phases
+                .iter()
+                .map(|p| Window {
+                    name: p.name.to_string(),
+                    t0_s: p.from_s,
+                    t1_s: p.to_s,
+                })
+                .collect();
+            run_residuals(r, raw, sigma, rho, phases)
         })
         .collect();
     let names: Vec<String> = problem

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use super::key_diagnose::KeyDriveDiagnosis;
 use super::report::{
     FILES, OUTCOMES, calibrated_table, check_out_dir, data_items, generator_mark, noise_check_html,
-    noise_check_markdown, throughput_html, throughput_markdown,
+    noise_check_markdown, noise_check_section, throughput_html, throughput_markdown,
 };
 use crate::error::{PianoError, Result};
 use crate::validate::page::PAGE_STYLE;
@@ -179,20 +179,12 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
         );
     }
     s.push('\n');
-    if let Some(c) = &d.noise_check {
-        s.push_str(&noise_check_markdown(
-            &format!(
-                "Does {} explain the data to the noise?",
-                d.best_candidate.as_deref().unwrap_or("the best candidate")
-            ),
-            c,
-        ));
-    } else {
-        s.push_str(&noise_check_markdown(
-            "Does the calibrated baseline explain the data to the noise?",
-            &d.baseline_noise_check,
-        ));
-    }
+    s.push_str(&noise_check_section(
+        d.best_candidate.as_deref(),
+        d.noise_check.as_ref(),
+        &d.baseline_noise_check,
+        noise_check_markdown,
+    ));
     s.push_str("\n## Candidates\n\n| effect | ΔBIC (whitened) | fit (µm) | held-out (µm) | parameters | kept | why | compute (core-s: screening + refit) |\n|---|---|---|---|---|---|---|---|\n");
     for c in &d.candidates {
         let params: Vec<String> = c
@@ -411,20 +403,12 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
         );
     }
     s.push_str("</tbody></table>\n");
-    if let Some(c) = &d.noise_check {
-        s.push_str(&noise_check_html(
-            &format!(
-                "Does {} explain the data to the noise?",
-                d.best_candidate.as_deref().unwrap_or("the best candidate")
-            ),
-            c,
-        ));
-    } else {
-        s.push_str(&noise_check_html(
-            "Does the calibrated baseline explain the data to the noise?",
-            &d.baseline_noise_check,
-        ));
-    }
+    s.push_str(&noise_check_section(
+        d.best_candidate.as_deref(),
+        d.noise_check.as_ref(),
+        &d.baseline_noise_check,
+        noise_check_html,
+    ));
     s.push_str("<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th><th>compute (core-s: screening + refit)</th></tr></thead><tbody>\n");
     for c in &d.candidates {
         let params: Vec<String> = c

@@ -148,20 +148,12 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
             um(p.after_rms_m)
         );
     }
-    if let Some(c) = &d.noise_check {
-        s.push_str(&noise_check_markdown(
-            &format!(
-                "Does {} explain the data to the noise?",
-                d.best_candidate.as_deref().unwrap_or("the best candidate")
-            ),
-            c,
-        ));
-    } else {
-        s.push_str(&noise_check_markdown(
-            "Does the calibrated baseline explain the data to the noise?",
-            &d.baseline_noise_check,
-        ));
-    }
+    s.push_str(&noise_check_section(
+        d.best_candidate.as_deref(),
+        d.noise_check.as_ref(),
+        &d.baseline_noise_check,
+        noise_check_markdown,
+    ));
     let _ = writeln!(s, "\n## Candidates\n");
     let _ = writeln!(
         s,
@@ -416,20 +408,12 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
         );
     }
     s.push_str("</tbody></table>\n");
-    if let Some(c) = &d.noise_check {
-        s.push_str(&noise_check_html(
-            &format!(
-                "Does {} explain the data to the noise?",
-                d.best_candidate.as_deref().unwrap_or("the best candidate")
-            ),
-            c,
-        ));
-    } else {
-        s.push_str(&noise_check_html(
-            "Does the calibrated baseline explain the data to the noise?",
-            &d.baseline_noise_check,
-        ));
-    }
+    s.push_str(&noise_check_section(
+        d.best_candidate.as_deref(),
+        d.noise_check.as_ref(),
+        &d.baseline_noise_check,
+        noise_check_html,
+    ));
     s.push_str("<h2>Candidates</h2>\n<table><thead><tr><th>effect</th><th>ΔBIC (whitened)</th><th>fit (µm)</th><th>held-out (µm)</th><th>parameters</th><th>kept</th><th>why</th></tr></thead><tbody>\n");
     for c in &d.candidates {
         let params: Vec<String> = c
@@ -470,6 +454,29 @@ pub(super) const OUTCOMES: &str = "named: one effect passes the selection rules,
     twice, so nothing is named and nothing added; none: the calibrated model explains the \
     data to the noise already; unexplained: it does not, and no candidate passes the \
     selection rules";
+
+/// The noise check of the best candidate's model when there is one, else the baseline's,
+/// rendered by `render` ([`noise_check_markdown`] or [`noise_check_html`]).
+pub(super) fn noise_check_section(
+    best: Option<&str>,
+    check: Option<&NoiseCheck>,
+    baseline: &NoiseCheck,
+    render: fn(&str, &NoiseCheck) -> String,
+) -> String {
+    match check {
+        Some(c) => render(
+            &format!(
+                "Does {} explain the data to the noise?",
+                best.unwrap_or("the best candidate")
+            ),
+            c,
+        ),
+        None => render(
+            "Does the calibrated baseline explain the data to the noise?",
+            baseline,
+        ),
+    }
+}
 
 /// The test a name must pass, in Markdown: whether the model (the best candidate's, or
 /// the baseline's) explains every run to the noise, and the cells and whiteness tests that
