@@ -4,9 +4,10 @@
 //! confusion matrix whose rows are the truths and whose columns are the decisions, with
 //! confident wrong names counted apart from honest `partly_explained` / `unexplained`.
 //!
-//! The CI tier diagnoses three short datasets; the study over seeds is `--ignored`:
+//! The CI tier diagnoses two short datasets; the study over seeds is `--ignored`:
 //! `cargo test --release -p piano-action --test confusion -- --ignored --nocapture`
-//! (`STUDY_SEEDS`, `STUDY_CASES` narrow it; each dataset's outcome is appended to
+//! (`STUDY_SEEDS` seeds from `STUDY_SEED_FROM`, and `STUDY_CASES`, narrow it; each
+//! dataset's outcome is appended to
 //! `target/confusion/outcomes.jsonl` as it comes, and the matrix printed at the end).
 
 mod truths;
@@ -180,6 +181,10 @@ fn confusion_matrix_over_independent_truths() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
+    let first: u64 = std::env::var("STUDY_SEED_FROM")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     let only: Option<Vec<String>> = std::env::var("STUDY_CASES")
         .ok()
         .map(|s| s.split(',').map(String::from).collect());
@@ -199,7 +204,7 @@ fn confusion_matrix_over_independent_truths() {
         .into_iter()
         .filter(|c| only.as_ref().is_none_or(|o| o.iter().any(|x| x == c.id)))
         .collect();
-    for seed in 1..=seeds {
+    for seed in first..first + seeds {
         for case in &cases {
             let d = diagnose_case(
                 case.id,

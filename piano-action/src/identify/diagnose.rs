@@ -899,11 +899,7 @@ pub fn diagnose(
     let best = best_of(&verdict);
     let best_check = best.map(|t| noise_check(&t.fit_raw, &t.heldout_raw));
     let shrink = best.map(|t| {
-        super::key_diagnose::excess_shrink(
-            flagged_before,
-            flagged_rms(&t.fit_raw, &t.heldout_raw),
-            sigma,
-        )
+        super::key_diagnose::plain_shrink(flagged_before, flagged_rms(&t.fit_raw, &t.heldout_raw))
     });
     let explains = best_check.as_ref().is_some_and(|c| c.explained)
         && shrink.is_some_and(|x| x >= super::key_diagnose::SHRINK_MIN);

@@ -276,7 +276,12 @@ pub fn charts(d: &KeyDriveDiagnosis) -> Vec<Chart> {
                 } else {
                     "corrected".into()
                 },
-                color: "#1f77b4",
+                // Orange for a candidate shown but not added, as in the replay.
+                color: if d.decision == "partly_explained" {
+                    "#e67e22"
+                } else {
+                    "#1f77b4"
+                },
                 points: thin(&tr.t, after.into_iter(), step),
                 mark: Mark::Line { dashed: false },
             });

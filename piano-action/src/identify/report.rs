@@ -448,7 +448,7 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
 /// What the decisions mean, for the pages (issue 33).
 pub(super) const OUTCOMES: &str = "named: one effect passes the selection rules, its model \
     explains every run, fitted and held out, to the noise, and it shrinks the flagged gap at \
-    least twice over the noise; ambiguous: several such effects the data cannot tell apart; \
+    least twice; ambiguous: several such effects the data cannot tell apart; \
     partly_explained: the best candidate passes the selection rules but leaves a phase \
     beyond the noise or residuals that are not white, or shrinks the flagged gap less than \
     twice, so nothing is named and nothing added; none: the calibrated model explains the \
