@@ -1,5 +1,5 @@
 // The key-drive diagnosis's replay: the action drawn to scale as the baseline (grey) and
-// the corrected model (blue; orange: the best candidate of a partial explanation) move it, the tracked markers over it (red: measured; crosses:
+// the corrected model (blue; purple: the best candidate of a partial explanation) move it, the tracked markers over it (red: measured; crosses:
 // the model's), the gap between them magnified. REPLAY is written by the report.
 (function () {
   const R = REPLAY;
@@ -16,7 +16,7 @@
   R.markers.forEach((m, i) => zoomSel.add(new Option('around ' + m, i)));
   [1, 10, 100].forEach((g) => gainSel.add(new Option('gap ×' + g, g)));
   gainSel.value = 10;
-  const colors = { baseline: '#888', corrected: '#1f77b4', 'best candidate': '#e67e22' };
+  const colors = { baseline: '#888', corrected: '#1f77b4', 'best candidate': '#8e44ad' };
 
   function bounds() {
     const b = { x0: Infinity, x1: -Infinity, y0: Infinity, y1: -Infinity };

@@ -276,9 +276,9 @@ pub fn charts(d: &KeyDriveDiagnosis) -> Vec<Chart> {
                 } else {
                     "corrected".into()
                 },
-                // Orange for a candidate shown but not added, as in the replay.
+                // Purple for a candidate shown but not added, as in the replay.
                 color: if d.decision == "partly_explained" {
-                    "#e67e22"
+                    "#8e44ad"
                 } else {
                     "#1f77b4"
                 },
@@ -369,7 +369,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     if let Some(replay) = &d.replay {
         s.push_str(
             "<h2>Replay</h2>\n<p>The action as the baseline (grey) and the corrected model \
-             (blue; orange: the best candidate when it explains only part of the gap) move it; crosses: the models' markers; red dots: the measured markers, \
+             (blue; purple: the best candidate when it explains only part of the gap) move it; crosses: the models' markers; red dots: the measured markers, \
              their gap to each model magnified.</p>\n<div class=\"controls\"><select \
              id=\"replay-run\"></select><select id=\"replay-zoom\"></select><select \
              id=\"replay-gain\"></select><button id=\"replay-play\">play</button><input \
