@@ -970,6 +970,18 @@ pub(super) fn plain_shrink(before: f64, after: f64) -> f64 {
     before / after.max(1e-300)
 }
 
+/// A run's phases as the noise check's windows.
+fn windows_of(phases: &[Phase]) -> Vec<Window> {
+    phases
+        .iter()
+        .map(|p| Window {
+            name: p.name.to_string(),
+            t0_s: p.from_s,
+            t1_s: p.to_s,
+        })
+        .collect()
+}
+
 /// Whether the model whose every run is `eval` (raw residuals and simulation, laid out as
 /// the problem's runs) explains the data to the noise: each run's residuals standardized
 /// by the noise floor and whitened with its correlation, cut by the model's own phases.
@@ -979,18 +991,7 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
         .runs
         .iter()
         .zip(eval)
-        .map(|(r, (raw, sim))| {
-            let phases = sim
-                .phases
-                .iter()
-                .map(|p| Window {
-                    name: p.name.to_string(),
-                    t0_s: p.from_s,
-                    t1_s: p.to_s,
-                })
-                .collect();
-            run_residuals(r, raw, sigma, rho, phases)
-        })
+        .map(|(r, (raw, sim))| run_residuals(r, raw, sigma, rho, windows_of(&sim.phases)))
         .collect();
     let names: Vec<String> = problem
         .dataset
@@ -1778,14 +1779,7 @@ pub fn diagnose_key_drive(
     // The shrink over the flagged phase judged as the noise check judges it: with the
     // phases after it when it lasts under 10 ms (a 1-frame free flight is no measure).
     let flag_window = {
-        let windows: Vec<Window> = base_phases
-            .iter()
-            .map(|p| Window {
-                name: p.name.to_string(),
-                t0_s: p.from_s,
-                t1_s: p.to_s,
-            })
-            .collect();
+        let windows = windows_of(&base_phases);
         let mid = 0.5
             * (flag_phase.from_s + flag_phase.to_s.min(r0.times.last().copied().unwrap_or(0.0)));
         merged(&windows, NoiseCheckOptions::default().min_cell_s)
