@@ -128,6 +128,16 @@ pub struct LmOptions {
     /// `ci95` NaN): for fits whose optimum alone is wanted, e.g. a screening.
     #[serde(default = "default_covariance")]
     pub covariance: bool,
+    /// Batches of the sandwich covariance (default 0: none, the covariance is
+    /// `s² (JᵀJ)⁻¹`). With `b ≥ 2` batches the residuals, in their order, are cut into `b`
+    /// contiguous blocks and the covariance is `(JᵀJ)⁻¹ M (JᵀJ)⁻¹`, `M` the sum over
+    /// blocks of the outer products of each block's score `Σ Jᵢᵀ rᵢ` (batch means, scaled
+    /// by `N/(N − k)`): it holds when the residuals are correlated over stretches shorter
+    /// than a block, as a model's structural error leaves them, where `s² (JᵀJ)⁻¹` takes
+    /// them for independent and gives intervals far too narrow. Each parameter's variance
+    /// is the larger of the two.
+    #[serde(default)]
+    pub score_batches: usize,
 }
 
 fn default_covariance() -> bool {
@@ -144,6 +154,7 @@ impl Default for LmOptions {
             central: false,
             threads: thread::available_parallelism().map_or(2, |n| n.get()),
             covariance: true,
+            score_batches: 0,
         }
     }
 }
@@ -790,7 +801,25 @@ where
             rss,
         } = at;
         let k = values.len();
-        let covariance_u = jac.and_then(|jac| covariance_internal(jac, rss, self.n));
+        let covariance_u = jac.and_then(|jac| {
+            let plain = covariance_internal(jac, rss, self.n)?;
+            if self.options.score_batches < 2 {
+                return Some(plain);
+            }
+            let sandwich = covariance_batch_means(jac, &residuals, self.options.score_batches)?;
+            // Each variance the larger of the two, the correlations the sandwich's.
+            let sd: Vec<f64> = (0..k)
+                .map(|i| plain[(i, i)].max(sandwich[(i, i)]).sqrt())
+                .collect();
+            let own: Vec<f64> = (0..k).map(|i| sandwich[(i, i)].sqrt()).collect();
+            Some(DMatrix::from_fn(k, k, |i, j| {
+                if i == j {
+                    sd[i] * sd[i]
+                } else {
+                    sandwich[(i, j)] / (own[i] * own[j]) * sd[i] * sd[j]
+                }
+            }))
+        });
         // Delta method: x = x(z), z = typical·u, so dx/du = typical·dx/dz.
         let grad: Vec<f64> = (0..k)
             .map(|i| self.axes[i].typical * self.axes[i].dx_dz(values[i]))
@@ -915,6 +944,52 @@ fn covariance_internal(jac: &[Vec<f64>], rss: f64, n: usize) -> Option<DMatrix<f
     let s2 = rss / (n - k) as f64;
     Some(DMatrix::from_fn(k, k, |i, j| {
         s2 * inverse[(i, j)] / (norm[i] * norm[j])
+    }))
+}
+
+/// The batch-means sandwich covariance in internal coordinates (see
+/// [`LmOptions::score_batches`]); `None` where [`covariance_internal`] gives none, or
+/// with fewer residuals than batches.
+fn covariance_batch_means(jac: &[Vec<f64>], r: &[f64], batches: usize) -> Option<DMatrix<f64>> {
+    let k = jac.len();
+    let n = r.len();
+    if k == 0 {
+        return Some(DMatrix::zeros(0, 0));
+    }
+    if n <= k || n < batches {
+        return None;
+    }
+    let a = gram(jac);
+    let norm: Vec<f64> = (0..k).map(|i| a[(i, i)].sqrt()).collect();
+    if norm.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
+        return None;
+    }
+    let unit = DMatrix::from_fn(k, k, |i, j| a[(i, j)] / (norm[i] * norm[j]));
+    let eig = SymmetricEigen::new(unit.clone()).eigenvalues;
+    let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &e| {
+        (lo.min(e), hi.max(e))
+    });
+    if lo <= SINGULAR_RCOND * hi {
+        return None;
+    }
+    let inverse = unit.cholesky()?.inverse();
+    // The meat: per block, the score of the unit-normalised columns.
+    let mut meat = DMatrix::<f64>::zeros(k, k);
+    for b in 0..batches {
+        let (from, to) = (b * n / batches, (b + 1) * n / batches);
+        let score: Vec<f64> = (0..k)
+            .map(|i| (from..to).map(|t| jac[i][t] * r[t]).sum::<f64>() / norm[i])
+            .collect();
+        for i in 0..k {
+            for j in 0..k {
+                meat[(i, j)] += score[i] * score[j];
+            }
+        }
+    }
+    meat *= n as f64 / (n - k) as f64;
+    let cov = &inverse * meat * &inverse;
+    Some(DMatrix::from_fn(k, k, |i, j| {
+        cov[(i, j)] / (norm[i] * norm[j])
     }))
 }
 

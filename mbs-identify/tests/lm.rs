@@ -441,3 +441,91 @@ fn a_fit_without_covariance_skips_only_the_last_jacobian() {
     }
     assert!(limited > 0, "no fit reached its step limit");
 }
+
+/// A line fitted through correlated errors it takes for independent ones (AR(1), ρ 0.95:
+/// a structural error's stretches of one sign): `s² (JᵀJ)⁻¹` covers the slope about one
+/// time in three, the batch-means sandwich about as often as it says.
+#[test]
+fn the_sandwich_holds_the_truth_where_the_errors_are_correlated() {
+    let (a_true, b_true, rho) = (1.0, 2.0, 0.95);
+    let n = 2000;
+    let seeds = 200;
+    let mut covered = [0usize; 2];
+    let mut width = [0.0; 2];
+    for seed in 0..seeds {
+        let mut noise = Noise::new(1000 + seed);
+        let mut e = noise.gaussian();
+        let data: Vec<(f64, f64)> = (0..n)
+            .map(|j| {
+                let t = j as f64 / n as f64;
+                e = rho * e + (1.0 - rho * rho).sqrt() * noise.gaussian();
+                (t, a_true + b_true * t + e)
+            })
+            .collect();
+        let params = vec![
+            FreeParam::linear("a", 0.0, -10.0, 10.0, 1.0),
+            FreeParam::linear("b", 0.0, -10.0, 10.0, 1.0),
+        ];
+        for (i, batches) in [0, 20].into_iter().enumerate() {
+            let options = LmOptions {
+                score_batches: batches,
+                ..LmOptions::default()
+            };
+            let fit = levenberg_marquardt(
+                &params,
+                |x: &[f64]| Ok(data.iter().map(|&(t, y)| x[0] + x[1] * t - y).collect()),
+                &options,
+            )
+            .unwrap();
+            let [lo, hi] = fit.ci95[1];
+            covered[i] += usize::from((lo..=hi).contains(&b_true));
+            width[i] += (hi - lo) / seeds as f64;
+        }
+    }
+    let rate = |c: usize| c as f64 / seeds as f64;
+    // Independent errors would have the plain interval cover 95 %; these are 39 times
+    // the variance it assumes (1 + ρ)/(1 − ρ), so it covers about 2Φ(1.96/√39) − 1 = 24 %.
+    eprintln!(
+        "coverage: plain {:.2}, sandwich {:.2}",
+        rate(covered[0]),
+        rate(covered[1])
+    );
+    assert!(
+        rate(covered[0]) < 0.5,
+        "plain covers {:.2}",
+        rate(covered[0])
+    );
+    // 20 batches of 100 points, each ~5 correlation lengths: the sandwich's variance has
+    // about 19 degrees of freedom, so ±1.96 SD covers about 93 %.
+    assert!(
+        (0.85..=0.99).contains(&rate(covered[1])),
+        "sandwich covers {:.2} (plain {:.2}; widths {:.3} vs {:.3})",
+        rate(covered[1]),
+        rate(covered[0]),
+        width[1],
+        width[0]
+    );
+}
+
+/// With independent errors the sandwich agrees with `s² (JᵀJ)⁻¹` (it is never narrower).
+#[test]
+fn with_independent_errors_the_sandwich_is_the_plain_interval() {
+    let data = decay_data(7);
+    let plain = fit_decay(&data, &LmOptions::default());
+    let sandwich = fit_decay(
+        &data,
+        &LmOptions {
+            score_batches: 20,
+            ..LmOptions::default()
+        },
+    );
+    for i in 0..2 {
+        assert_eq!(plain.values[i], sandwich.values[i]);
+        let ratio = sandwich.sd[i] / plain.sd[i];
+        // Never narrower; wider by at most what 20 batches' sampling error allows.
+        assert!(
+            (1.0..1.6).contains(&ratio),
+            "param {i}: sd ratio {ratio:.3}"
+        );
+    }
+}

@@ -107,15 +107,54 @@ fn diagnose_case(
     generate: &GenOptions,
     options: &KeyDiagnoseOptions,
 ) -> KeyDriveDiagnosis {
+    diagnose_with_truth(case, seed, generate, options).0
+}
+
+/// Where a truth's effect has a value the library's parameter stands for (the same
+/// quantity of the same form): each such parameter and its true value. A flex at one
+/// place: its compliance (the truth's 1/k) and place; a felt's exponent; a friction's
+/// coefficient step. Forms the library has no parameter for (three hinges, a slide) have
+/// none.
+fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, f64)> {
+    let get = |k: &str| effect.get(k).copied();
+    let mut out = Vec::new();
+    match case {
+        "key_flex_far" | "shank_flex_mid" => {
+            if let Some(k) = get("k_n_m_per_rad") {
+                out.push(("compliance_rad_n_m", 1.0 / k));
+            }
+        }
+        "keybed_felt_p3" | "knuckle_felt_hc" => {
+            if let Some(p) = get("p") {
+                out.push(("p", p));
+            }
+        }
+        "knuckle_friction_visc" => {
+            if let Some(d) = get("dmu") {
+                out.push(("dmu", d));
+            }
+        }
+        _ => {}
+    }
+    out
+}
+
+/// [`diagnose_case`], with the truth's effect values.
+fn diagnose_with_truth(
+    case: &str,
+    seed: u64,
+    generate: &GenOptions,
+    options: &KeyDiagnoseOptions,
+) -> (KeyDriveDiagnosis, BTreeMap<String, f64>) {
     let dir = scratch(&format!("{case}-{seed}"));
     let truth = dir.with_extension("truth.json");
-    truths::generate(case, seed, &dir, &truth, generate).expect("generates");
+    let record = truths::generate(case, seed, &dir, &truth, generate).expect("generates");
     let ds = Dataset::load(&dir).expect("reads back");
     let d = diagnose_key_drive(&ActionParams::reference(), &ds, options, &|_, _| {})
         .expect("diagnoses");
     std::fs::remove_dir_all(&dir).ok();
     std::fs::remove_file(&truth).ok();
-    d
+    (d, record.effect)
 }
 
 fn short() -> GenOptions {
@@ -199,6 +238,7 @@ fn confusion_matrix_over_independent_truths() {
     let mut scores: BTreeMap<Score, usize> = BTreeMap::new();
     let (mut total, mut right) = (0usize, 0usize);
     let (mut outside_named, mut negatives, mut negatives_none) = (0usize, 0usize, 0usize);
+    let (mut intervals, mut covered) = (0usize, 0usize);
     // Seed by seed over every case, so that a study cut short still covers every case.
     let cases: Vec<truths::Case> = truths::cases()
         .into_iter()
@@ -206,13 +246,25 @@ fn confusion_matrix_over_independent_truths() {
         .collect();
     for seed in first..first + seeds {
         for case in &cases {
-            let d = diagnose_case(
+            let (d, truth) = diagnose_with_truth(
                 case.id,
                 seed,
                 &GenOptions::default(),
                 &KeyDiagnoseOptions::default(),
             );
             let s = score(&case.expected, &d);
+            // A named effect's comparable values: inside their 95 % interval?
+            let mut inside = Vec::new();
+            if let (Score::NamedRight, Some(e)) = (s, d.effects.first()) {
+                for (name, value) in comparable(case.id, &truth) {
+                    if let Some(&[lo, hi]) = e.ci95.get(name) {
+                        let hit = (lo..=hi).contains(&value);
+                        intervals += 1;
+                        covered += usize::from(hit);
+                        inside.push(serde_json::json!({"param": name, "truth": value, "ci95": [lo, hi], "inside": hit}));
+                    }
+                }
+            }
             let col = column(&d);
             let secs: f64 = d.timing.iter().map(|(_, t)| t).sum();
             eprintln!(
@@ -230,6 +282,7 @@ fn confusion_matrix_over_independent_truths() {
                     "best_params": d.best_candidate.as_ref().and_then(|b| d.candidates.iter().find(|c| &c.id == b)).map(|c| c.params.clone()),
                     "noise_check": d.noise_check.as_ref().map(|c| serde_json::json!({"explained": c.explained, "summary": c.summary()})),
                     "baseline_explained": d.baseline_noise_check.explained,
+                    "truth": truth, "intervals": inside,
                     "seconds": secs,
                 })
             );
@@ -258,11 +311,16 @@ fn confusion_matrix_over_independent_truths() {
     let wrong = scores.get(&Score::NamedWrong).copied().unwrap_or(0);
     eprintln!(
         "right {right}/{total}; confident wrong names {wrong}/{total}; outside the library \
-         named {outside_named}; negatives none {negatives_none}/{negatives}; {scores:?}"
+         named {outside_named}; negatives none {negatives_none}/{negatives}; named values \
+         inside their 95 % interval {covered}/{intervals}; {scores:?}"
     );
     assert!(right * 10 >= total * 9, "right {right}/{total}");
     assert!(wrong * 50 <= total, "confident wrong names {wrong}/{total}");
     assert_eq!(outside_named, 0, "effects outside the library named");
+    assert!(
+        covered * 10 >= intervals * 8,
+        "named values inside their 95 % interval {covered}/{intervals}"
+    );
     assert!(
         negatives_none * 10 >= negatives * 9,
         "none {negatives_none}/{negatives}"

@@ -25,7 +25,8 @@ use crate::params::ActionParams;
 /// The key bends: its back arm on a torsion spring `cut_m` behind the balance pivot (20 mm
 /// typically; anywhere from the balance hole to the back-check, 10–190 mm [D]: a real key
 /// bends where its wood is weakest, and the one hinge stands for its first mode; past the
-/// capstan at 110 mm the capstan stays on the front part). Range
+/// capstan at 110 mm the capstan stays on the front part; screened at 20, 70 and 130 mm,
+/// each refitted). Range
 /// [D] `identification.md` §3.5: a basswood key (EI ≈ 200 N·m²) over its 0.2 m back arm
 /// is about 3 EI/L ≈ 3000 N·m/rad at the rail; the plausible range allows 30 times softer
 /// (a cracked or thin key) and 30 times stiffer. The typical (visible) value, 1e-3
@@ -53,7 +54,7 @@ pub const KEY_FLEX: EffectSpec = EffectSpec {
             range: [0.01, 0.19],
             typical: 0.02,
             log_scale: false,
-            screen: &[],
+            screen: &[0.02, 0.07, 0.13],
         },
     ],
     confusable_with: &["backcheck_compliance", "keybed_felt", "shank_flex"],
@@ -63,9 +64,8 @@ pub const KEY_FLEX: EffectSpec = EffectSpec {
 
 /// The hammer shank bends: the head on a torsion spring `root_m` along the shank (at the
 /// head's root, 110 mm, typically; anywhere from 30 mm, beyond the knuckle, to 115 mm
-/// [D]: the one hinge stands for the shank's first mode, wherever it bends most). Range
-/// [D]: a
-/// hornbeam shank (d ≈ 8 mm, EI ≈ 2 N·m²) is some 40 N·m/rad at the head's root; the
+/// [D]: the one hinge stands for the shank's first mode, wherever it bends most; screened
+/// at 40, 75 and 110 mm, each refitted). Range [D]: a hornbeam shank (d ≈ 8 mm, EI ≈ 2 N·m²) is some 40 N·m/rad at the head's root; the
 /// range allows 10 times stiffer and 80 times softer. The typical (visible) value, 0.15
 /// rad/(N·m) (a thin shank, 6 times softer than that estimate), is where the gap after
 /// the check's catch holds several noise floors under nuisance: at 0.05 the calibrated
@@ -91,7 +91,7 @@ pub const SHANK_FLEX: EffectSpec = EffectSpec {
             range: [0.03, 0.115],
             typical: 0.11,
             log_scale: false,
-            screen: &[],
+            screen: &[0.04, 0.075, 0.11],
         },
     ],
     confusable_with: &["backcheck_compliance", "key_flex"],
@@ -201,9 +201,8 @@ pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
 
 /// A felt's force-law exponent [S] `identification.md` §2 (power laws F = Q₀ xᵖ with p ≈
 /// 2–5 from hammer-felt experiments, Boutillon 1988): from 1.5 (a thin, hard punching) to
-/// 4; the file's action felts are 2. Free in the refit from the file's 2 (screening it at
-/// 3 as well sent the refit of the library's own bending key into another basin: its
-/// location and exponent are refitted, not screened, for now).
+/// 4; the file's action felts are 2. Free in the refit from the file's 2, not screened:
+/// two more screened values would cost the diagnosis some 35 s on two cores.
 const FELT_EXPONENT: EffectParam = EffectParam {
     name: "p",
     unit: "",
