@@ -917,17 +917,11 @@ fn gram(jac: &[Vec<f64>]) -> DMatrix<f64> {
     a
 }
 
-/// s² (JᵀJ)⁻¹ in units of typical, or `None` if JᵀJ is numerically singular or N ≤ k.
-fn covariance_internal(jac: &[Vec<f64>], rss: f64, n: usize) -> Option<DMatrix<f64>> {
+/// `(JᵀJ)⁻¹` of the unit-normalised columns and the columns' norms (so that the
+/// singularity test is scale-free), or `None` if JᵀJ is numerically singular.
+fn normalized_inverse(jac: &[Vec<f64>]) -> Option<(DMatrix<f64>, Vec<f64>)> {
     let k = jac.len();
-    if k == 0 {
-        return Some(DMatrix::zeros(0, 0));
-    }
-    if n <= k {
-        return None;
-    }
     let a = gram(jac);
-    // Normalise the columns to unit length so the singularity test is scale-free.
     let norm: Vec<f64> = (0..k).map(|i| a[(i, i)].sqrt()).collect();
     if norm.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
         return None;
@@ -940,7 +934,19 @@ fn covariance_internal(jac: &[Vec<f64>], rss: f64, n: usize) -> Option<DMatrix<f
     if lo <= SINGULAR_RCOND * hi {
         return None;
     }
-    let inverse = unit.cholesky()?.inverse();
+    Some((unit.cholesky()?.inverse(), norm))
+}
+
+/// s² (JᵀJ)⁻¹ in units of typical, or `None` if JᵀJ is numerically singular or N ≤ k.
+fn covariance_internal(jac: &[Vec<f64>], rss: f64, n: usize) -> Option<DMatrix<f64>> {
+    let k = jac.len();
+    if k == 0 {
+        return Some(DMatrix::zeros(0, 0));
+    }
+    if n <= k {
+        return None;
+    }
+    let (inverse, norm) = normalized_inverse(jac)?;
     let s2 = rss / (n - k) as f64;
     Some(DMatrix::from_fn(k, k, |i, j| {
         s2 * inverse[(i, j)] / (norm[i] * norm[j])
@@ -959,20 +965,7 @@ fn covariance_batch_means(jac: &[Vec<f64>], r: &[f64], batches: usize) -> Option
     if n <= k || n < batches {
         return None;
     }
-    let a = gram(jac);
-    let norm: Vec<f64> = (0..k).map(|i| a[(i, i)].sqrt()).collect();
-    if norm.iter().any(|&v| !(v > 0.0 && v.is_finite())) {
-        return None;
-    }
-    let unit = DMatrix::from_fn(k, k, |i, j| a[(i, j)] / (norm[i] * norm[j]));
-    let eig = SymmetricEigen::new(unit.clone()).eigenvalues;
-    let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &e| {
-        (lo.min(e), hi.max(e))
-    });
-    if lo <= SINGULAR_RCOND * hi {
-        return None;
-    }
-    let inverse = unit.cholesky()?.inverse();
+    let (inverse, norm) = normalized_inverse(jac)?;
     // The meat: per block, the score of the unit-normalised columns.
     let mut meat = DMatrix::<f64>::zeros(k, k);
     for b in 0..batches {
