@@ -187,9 +187,19 @@ pub struct NoiseCheck {
     pub cells: Vec<CellCheck>,
     /// Every whiteness test.
     pub whiteness: Vec<WhitenessCheck>,
+    /// What else keeps the model from explaining the data, found by the caller (see
+    /// [`NoiseCheck::fail_also`]).
+    pub also: Vec<String>,
 }
 
 impl NoiseCheck {
+    /// Marks the model as not explaining the data, for `why` (a rule of the caller's
+    /// beyond the cells and the whiteness).
+    pub fn fail_also(&mut self, why: impl Into<String>) {
+        self.explained = false;
+        self.also.push(why.into());
+    }
+
     /// One sentence on what is left, or that nothing is.
     pub fn summary(&self) -> String {
         if self.explained {
@@ -224,6 +234,7 @@ impl NoiseCheck {
                 .collect();
             parts.push(format!("residuals not white ({})", names.join(", ")));
         }
+        parts.extend(self.also.iter().cloned());
         parts.join("; ")
     }
 }
@@ -316,6 +327,7 @@ pub fn check_noise(
         not_white,
         cells,
         whiteness,
+        also: Vec::new(),
     }
 }
 
