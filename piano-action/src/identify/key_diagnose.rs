@@ -1096,21 +1096,29 @@ impl<'a> Problem<'a> {
             }
             t
         };
+        // Each run's release and clock: a fitted run's as fitted, a held-out run's free.
+        let releases = |t: &Setting, x: &[f64]| -> Vec<(f64, f64)> {
+            let (mut fit_i, mut held_i) = (0, 0);
+            self.runs
+                .iter()
+                .map(|r| {
+                    if r.role == Role::Fit {
+                        fit_i += 1;
+                        t.runs[fit_i - 1]
+                    } else {
+                        held_i += 1;
+                        let at = physics + n_tol + 2 * (held_i - 1);
+                        (x[at], x[at + 1])
+                    }
+                })
+                .collect()
+        };
         let recent = Recent::new((free.len() + 1) * self.runs.len());
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
             self.work.add_evaluation();
             let t = setting_at(x);
             let mut out = Vec::new();
-            let (mut fit_i, mut held_i) = (0, 0);
-            for (i, r) in self.runs.iter().enumerate() {
-                let (h, off) = if r.role == Role::Fit {
-                    fit_i += 1;
-                    t.runs[fit_i - 1]
-                } else {
-                    held_i += 1;
-                    let at = physics + n_tol + 2 * (held_i - 1);
-                    (x[at], x[at + 1])
-                };
+            for (i, (r, (h, off))) in self.runs.iter().zip(releases(&t, x)).enumerate() {
                 let predicted = self
                     .predict_until(&recent, &t, (i, r), h, off, f64::INFINITY)
                     .map_err(|e| e.to_string())?;
@@ -1133,16 +1141,7 @@ impl<'a> Problem<'a> {
             .map_err(|e| PianoError::Simulation(format!("joint refit: {e}")))?;
         let t = setting_at(&fit.values);
         let mut out = Vec::new();
-        let (mut fit_i, mut held_i) = (0, 0);
-        for r in &self.runs {
-            let (h, off) = if r.role == Role::Fit {
-                fit_i += 1;
-                t.runs[fit_i - 1]
-            } else {
-                held_i += 1;
-                let at = physics + n_tol + 2 * (held_i - 1);
-                (fit.values[at], fit.values[at + 1])
-            };
+        for (r, (h, off)) in self.runs.iter().zip(releases(&t, &fit.values)) {
             let sim = self.simulate(&t, r, h, off)?;
             out.push((raw(r, &sim.predicted), sim));
         }
