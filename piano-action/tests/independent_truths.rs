@@ -404,3 +404,47 @@ fn write_dataset() {
         .unwrap_or_else(|e| panic!("{e}"));
     eprintln!("{}: {} ({})", out.display(), record.case, record.expected);
 }
+
+/// An effect's size in the clean film, against the same action without it: nothing for
+/// the negative, millimetres for a key bent behind its pivot (the hammer leaves the
+/// back-check), and the same whichever way it is asked.
+#[test]
+fn an_effects_visibility_is_measured_against_the_action_without_it() {
+    let options = GenOptions {
+        duration_s: 0.15,
+        heights: Heights::FittedOnly,
+    };
+    let none = truths::visibility("none", 1, &options).expect("none");
+    assert_eq!(none, 0.0);
+    let bent = truths::visibility("key_flex_far", 1, &options).expect("key_flex_far");
+    assert!(bent > 5.0, "a key of 1258 N·m/rad: {bent:.2} σ");
+    assert_eq!(
+        bent,
+        truths::visibility("key_flex_far", 1, &options).expect("again")
+    );
+    assert!(truths::visibility("no_such_case", 1, &options).is_err());
+}
+
+/// Prints each case's visibility over seeds (`STUDY_SEEDS` from `STUDY_SEED_FROM`, 5 from
+/// 1 by default): how large an effect the confusion matrix's rows ask to find.
+#[test]
+#[ignore]
+fn print_visibility() {
+    let seeds: u64 = std::env::var("STUDY_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
+    let first: u64 = std::env::var("STUDY_SEED_FROM")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    for case in truths::cases() {
+        let row: Vec<String> = (first..first + seeds)
+            .map(|seed| {
+                truths::visibility(case.id, seed, &GenOptions::default())
+                    .map_or_else(|e| e, |v| format!("{v:.1}"))
+            })
+            .collect();
+        eprintln!("| `{}` | {} |", case.id, row.join(" | "));
+    }
+}

@@ -176,9 +176,14 @@ pub fn tolerance_of(path: &str, value: f64) -> Option<f64> {
     }
 }
 
-/// A tolerance read as a 95 % range: the SD of a value's move in the refit on every run,
-/// as a fraction of its tolerance [D].
-pub const TOLERANCE_SD: f64 = 0.5;
+/// The SD of a value's move in the refit on every run, as a fraction of its tolerance
+/// [S]: a tolerance read as the half-width of a uniform spread (the reading of a maker's
+/// bound with nothing more known, and how `identification.md` §5.1 draws the nuisance),
+/// whose SD is 1/√3 of it. Read as a 95 % range (SD half the tolerance), the Gaussian
+/// term held each value tighter than the spread it stands for: a nuisance drawn from
+/// that spread and recovered exactly gave squared moves summing to 4/3 of their count, so
+/// that the χ² test rejected actions within their makers' tolerance.
+pub const TOLERANCE_SD: f64 = 0.577_350_269_189_625_8;
 
 /// The least factor by which a named effect must shrink the flagged phase's gap [S]
 /// issue 33 ("a candidate that shrinks the flagged gap less than 2× is never named";
@@ -340,7 +345,11 @@ pub struct KeyDriveDiagnosis {
     pub separating_experiment: Option<String>,
     /// Every candidate tried.
     pub candidates: Vec<KeyCandidate>,
-    /// The calibrated values (with the effect's when one is added).
+    /// Whose values `calibrated`, `at_bound` and `tolerated` are: `baseline`, or the id of
+    /// the effect the report shows (named, the best of an ambiguity, or a partial
+    /// explanation's).
+    pub values_of: String,
+    /// The calibrated values of the model `values_of` names.
     pub calibrated: BTreeMap<String, f64>,
     /// The values calibrated on the rise alone (the frames before the string), the trusted
     /// phase.
@@ -351,8 +360,8 @@ pub struct KeyDriveDiagnosis {
     /// tolerance ([`tolerance_of`]) by the refit on every run: path, factor on the file's
     /// value. Empty without a held-out run.
     pub tolerated: BTreeMap<String, f64>,
-    /// The probability of moves as large as `tolerated`'s, the tolerances read as 95 %
-    /// ranges; below [`MOVED_P_MIN`] the model does not explain the data.
+    /// The probability of moves as large as `tolerated`'s, the tolerances read as uniform
+    /// spreads; below [`MOVED_P_MIN`] the model does not explain the data.
     pub tolerated_p: Option<f64>,
     /// What the baseline calibration frees.
     pub calibration_frees: Vec<String>,
@@ -1202,7 +1211,7 @@ struct Moved {
 }
 
 impl Moved {
-    /// The probability of moves as large, their tolerances read as 95 % ranges.
+    /// The probability of moves as large, their tolerances read as uniform spreads.
     fn p(&self) -> f64 {
         if self.dof == 0 {
             1.0
@@ -2317,15 +2326,20 @@ pub fn diagnose_key_drive(
         .filter(|(p, at)| **at && !p.name.starts_with("effects."))
         .map(|(p, _)| p.name)
         .collect();
-    // With a held-out run, the values are those that explain every run at once.
-    let joint = match chosen {
-        Some(_) => after_eval,
-        None => &base_eval[..],
-    }
-    .iter()
-    .find_map(|(_, s)| s.moved.as_ref());
+    // With a held-out run, the values are those of the model shown (the chosen one, a
+    // partial explanation's best candidate, or the baseline) that explain every run at
+    // once: a partial explanation's show which file values it had to move, and how far.
+    let joint = after_eval.iter().find_map(|(_, s)| s.moved.as_ref());
     let at_bound = joint.map_or(at_bound, |j| j.at_bound.clone());
     let values_of = joint.map_or(after_setting, |j| &j.setting);
+    let label = |b: Option<usize>| {
+        b.map_or_else(|| "baseline".to_string(), |b| tried[b].spec.id.to_string())
+    };
+    let values_label = if joint.is_some() {
+        label(shown)
+    } else {
+        label(chosen)
+    };
     let mut calibrated = BTreeMap::new();
     for ((name, _), v) in CALIBRATED.iter().zip(values_of.cal) {
         calibrated.insert(name.to_string(), v);
@@ -2405,6 +2419,7 @@ pub fn diagnose_key_drive(
             .map(|((name, _), v)| (name.to_string(), v))
             .collect(),
         at_bound,
+        values_of: values_label,
         tolerated,
         tolerated_p: joint.map(Moved::p),
         calibration_frees: free.into_iter().map(|p| p.name).collect(),

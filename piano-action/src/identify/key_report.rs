@@ -114,20 +114,47 @@ fn tolerated_text(d: &KeyDriveDiagnosis, html: bool) -> String {
     let Some(p) = d.tolerated_p else {
         return String::new();
     };
+    let model = if d.values_of == "baseline" {
+        "the baseline".to_string()
+    } else if d.decision == "partly_explained" {
+        format!(
+            "the baseline with {} (the partial explanation)",
+            d.values_of
+        )
+    } else {
+        format!("the baseline with {}", d.values_of)
+    };
     let text = format!(
-        "The values of one refit on every run, fitted and held out (each held-out run's \
-         release and clock free), with the {} values the calibration holds at the file's \
-         free within their makers' tolerance (friction and contact stiffness ±20 %, masses \
-         ±3 %, read as 95 % ranges): how the model is judged on a run it was not fitted to. \
-         The moves' probability: p = {p:.2} (below {} the model does not explain the \
-         data).",
+        "The values of {model}, refitted once on every run, fitted and held out (each \
+         held-out run's release and clock free), with the {} values the calibration holds \
+         at the file's free under their makers' tolerance (friction and contact stiffness \
+         ±20 %, masses ±3 %, each read as a uniform spread; searched to twice it): how the \
+         model is judged on a run it was not fitted to. The moves' probability, all \
+         together: p = {} (below {} the model does not explain the data).",
         d.tolerated.len(),
+        if p >= 0.01 {
+            format!("{p:.2}")
+        } else {
+            format!("{p:.1e}")
+        },
         super::key_diagnose::MOVED_P_MIN
     );
     if html {
         format!("<p>{}</p>\n", escape(&text))
     } else {
         format!("{text}\n\n")
+    }
+}
+
+/// A tolerated value's tolerance, and whether the refit moved it beyond (`factor` on the
+/// file's value).
+fn tolerance_note(path: &str, factor: f64) -> String {
+    match super::key_diagnose::tolerance_of(path, 1.0) {
+        Some(tol) if factor.ln().abs() > (1.0 + tol).ln() + 1e-9 => {
+            format!("tolerance ±{:.0} %, beyond it", 100.0 * tol)
+        }
+        Some(tol) => format!("tolerance ±{:.0} %", 100.0 * tol),
+        None => String::new(),
     }
 }
 
@@ -236,7 +263,7 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
         let _ = writeln!(s, "- `{k}` = {v:.6e}");
     }
     for (k, v) in &d.tolerated {
-        let _ = writeln!(s, "- `{k}` ×{v:.3} (within its tolerance)");
+        let _ = writeln!(s, "- `{k}` ×{v:.3} ({})", tolerance_note(k, *v));
     }
     let _ = writeln!(
         s,
@@ -335,7 +362,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
          {}\n<title>{}</title>\n\
          <style>{PAGE_STYLE}.decision{{font-size:17px;padding:8px 12px;background:#f4f8fc;border-left:4px solid #1f77b4}}\
          #replay{{width:100%;max-width:980px;height:560px;border:1px solid #ccc;display:block}}\
-         .controls{{margin:6px 0}} .controls *{{margin-right:8px}}</style>\n\
+         .controls{{margin:6px 0}} .controls *{{margin-right:8px}} tr.beyond td{{color:#b00}}</style>\n\
          </head>\n<body>\n<h1>{}</h1>\n<p class=\"decision\"><b>Decision: {}.</b> {}</p>\n<p><i>Outcomes.</i> {}.</p>\n",
         generator_mark("report.html"),
         escape(&title),
@@ -467,8 +494,25 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     s.push_str(&tolerated_text(d, true));
     s.push_str(&calibrated_table(&d.calibrated));
     if !d.tolerated.is_empty() {
-        s.push_str("<p>Held at the file's, moved within their makers' tolerance (factor on the file's value):</p>\n");
-        s.push_str(&calibrated_table(&d.tolerated));
+        s.push_str(
+            "<p>Held at the file's, moved by the refit (factor on the file's value, and \
+             the makers' tolerance):</p>\n<table><tbody>\n",
+        );
+        for (k, v) in &d.tolerated {
+            let note = tolerance_note(k, *v);
+            let _ = writeln!(
+                s,
+                "<tr{}><td><code>{}</code></td><td class=\"num\">×{v:.3}</td><td>{}</td></tr>",
+                if note.contains("beyond") {
+                    " class=\"beyond\""
+                } else {
+                    ""
+                },
+                escape(k),
+                escape(&note)
+            );
+        }
+        s.push_str("</tbody></table>\n");
     }
     s.push_str("<p>On the rise alone:</p>\n");
     s.push_str(&calibrated_table(&d.rise_calibrated));
