@@ -21,6 +21,7 @@ use piano_action::identify::action_effects::action_effect_spec;
 use piano_action::identify::key_diagnose::{
     KeyDiagnoseOptions, KeyDriveDiagnosis, diagnose_key_drive, tolerance_of,
 };
+use piano_action::identify::key_report::{beyond_tolerance, markdown};
 use piano_action::params::ActionParams;
 use truths::{Expected, GenOptions};
 
@@ -254,6 +255,14 @@ fn confusion_matrix_over_independent_truths() {
     let only: Option<Vec<String>> = std::env::var("STUDY_CASES")
         .ok()
         .map(|s| s.split(',').map(String::from).collect());
+    // The code's revision, so that outcomes of different code in the log stay apart.
+    let rev = std::process::Command::new("git")
+        .args(["describe", "--always", "--dirty"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map_or_else(|| "unknown".to_string(), |s| s.trim().to_string());
     let out_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/confusion");
     std::fs::create_dir_all(&out_dir).expect("target/confusion");
     let mut log = std::fs::OpenOptions::new()
@@ -294,16 +303,9 @@ fn confusion_matrix_over_independent_truths() {
             }
             let col = column(&d);
             let secs: f64 = d.timing.iter().map(|(_, t)| t).sum();
-            // The effect's own size in the film, before any model: independent of the
-            // diagnosis.
-            let visible = truths::visibility(case.id, seed, &GenOptions::default()).ok();
             eprintln!(
-                "{:24} seed {seed}: {:40} {:?} ({secs:.0} s; effect {:.1} σ in the clean film) {}",
-                case.id,
-                col,
-                s,
-                visible.unwrap_or(f64::NAN),
-                d.summary
+                "{:24} seed {seed}: {:40} {:?} ({secs:.0} s) {}",
+                case.id, col, s, d.summary
             );
             let _ = writeln!(
                 log,
@@ -317,7 +319,7 @@ fn confusion_matrix_over_independent_truths() {
                     "noise_check": d.noise_check.as_ref().map(|c| serde_json::json!({"explained": c.explained, "summary": c.summary()})),
                     "baseline_explained": d.baseline_noise_check.explained,
                     "truth": truth, "intervals": inside,
-                    "seconds": secs, "visibility_sigma": visible,
+                    "seconds": secs, "rev": rev,
                 })
             );
             *matrix
@@ -384,22 +386,49 @@ fn a_partial_explanation_reports_the_values_it_had_to_move() {
     assert!(!check.explained);
     let p = d.tolerated_p.expect("a joint refit with a held-out run");
     assert!(p < 0.01, "the tolerated moves' probability {p}");
-    let (farthest, _) = d
-        .tolerated
-        .iter()
-        .max_by(|a, b| a.1.ln().abs().total_cmp(&b.1.ln().abs()))
-        .expect("tolerated values");
+    // The values are the candidate's refit on both drops: the p its summary gives, and
+    // its effect among the calibrated values.
     assert!(
-        d.summary.contains(farthest.as_str()),
-        "{farthest}: {}",
+        d.summary.contains(&format!("p {p:.1e}")),
+        "p {p:.1e}: {}",
         d.summary
     );
-    // Every tolerated factor within its search range (twice the tolerance).
-    for (path, f) in &d.tolerated {
-        let tol = tolerance_of(path, 1.0).expect("a tolerance");
+    assert!(
+        d.calibrated
+            .contains_key("effects.key_flex.compliance_rad_n_m")
+    );
+    // The value the summary names is one moved farthest (ties at a bound are equal).
+    let farthest = d
+        .tolerated
+        .values()
+        .map(|f| f.ln().abs())
+        .fold(0.0, f64::max);
+    let named = d
+        .tolerated
+        .iter()
+        .find(|(k, _)| d.summary.contains(&format!("{k} ×")))
+        .map(|(_, f)| f.ln().abs())
+        .expect("a tolerated value named in the summary");
+    assert!((named - farthest).abs() < 1e-9, "{named} vs {farthest}");
+    // The report lists them with their tolerance, those beyond it marked.
+    let beyond: Vec<&String> = d
+        .tolerated
+        .iter()
+        .filter(|(k, f)| beyond_tolerance(k, **f))
+        .map(|(k, _)| k)
+        .collect();
+    assert!(!beyond.is_empty());
+    let md = markdown(&d, std::path::Path::new("mass_pad"));
+    assert!(md.contains("the baseline with key_flex (the partial explanation)"));
+    for k in &beyond {
+        let tol = tolerance_of(k, 1.0).expect("a tolerance");
         assert!(
-            (1.0 / (1.0 + 2.0 * tol) - 1e-9..=1.0 + 2.0 * tol + 1e-9).contains(f),
-            "{path} ×{f}"
+            md.contains(&format!(
+                "`{k}` ×{:.3} (tolerance ±{:.0} %, beyond it)",
+                d.tolerated[*k],
+                100.0 * tol
+            )),
+            "{k}"
         );
     }
 }

@@ -289,3 +289,29 @@ fn study_over_seeds() {
     assert!(wrong * 10 <= total, "wrong {wrong}/{total}");
     assert!(none_ok * 5 >= negatives * 4, "none {none_ok}/{negatives}");
 }
+
+/// A maker's tolerance is read as a uniform spread of the factor over 1 ± tol: the SD of
+/// its logarithm, against a midpoint-rule integral of the spread.
+#[test]
+fn a_tolerance_is_read_as_a_uniform_spread() {
+    use piano_action::identify::key_diagnose::tolerance_sd;
+    for tol in [0.03, 0.15, 0.2] {
+        let n = 200_000;
+        let (mut m1, mut m2) = (0.0, 0.0);
+        for i in 0..n {
+            let x = 1.0 - tol + 2.0 * tol * (i as f64 + 0.5) / n as f64;
+            m1 += x.ln() / n as f64;
+            m2 += x.ln().powi(2) / n as f64;
+        }
+        let sd = (m2 - m1 * m1).sqrt();
+        assert!(
+            (tolerance_sd(tol) - sd).abs() < 1e-6 * sd,
+            "±{tol}: {} vs {sd}",
+            tolerance_sd(tol)
+        );
+        // Wider than the plain tol/√3 on the log scale for a wide spread (the log stretches
+        // the low side), and close to it for a narrow one.
+        assert!(tolerance_sd(tol) >= tol / 3f64.sqrt());
+    }
+    assert!((tolerance_sd(0.2) - 0.117).abs() < 5e-4);
+}

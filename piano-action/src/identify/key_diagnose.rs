@@ -148,7 +148,7 @@ pub const HELDOUT_WORSEN_MAX: f64 = 0.1;
 
 /// The least probability of how far the refit on every run moved the values held at the
 /// file's within their tolerance [D] (a χ² tail over the values moved, each standardized
-/// by [`TOLERANCE_SD`]): below it the runs asked for an action its makers would not hold
+/// by [`tolerance_sd`]): below it the runs asked for an action its makers would not hold
 /// to, and the model does not explain them.
 pub const MOVED_P_MIN: f64 = 0.01;
 
@@ -176,14 +176,21 @@ pub fn tolerance_of(path: &str, value: f64) -> Option<f64> {
     }
 }
 
-/// The SD of a value's move in the refit on every run, as a fraction of its tolerance
-/// [S]: a tolerance read as the half-width of a uniform spread (the reading of a maker's
-/// bound with nothing more known, and how `identification.md` §5.1 draws the nuisance),
-/// whose SD is 1/√3 of it. Read as a 95 % range (SD half the tolerance), the Gaussian
-/// term held each value tighter than the spread it stands for: a nuisance drawn from
-/// that spread and recovered exactly gave squared moves summing to 4/3 of their count, so
-/// that the χ² test rejected actions within their makers' tolerance.
-pub const TOLERANCE_SD: f64 = 0.577_350_269_189_625_8;
+/// The SD of the logarithm of a value's factor in the refit on every run, for a
+/// tolerance `tol` (a fraction) [S]: the factor read as spread uniformly over
+/// [1 − tol, 1 + tol] (the reading of a maker's bound with nothing more known, and how
+/// `identification.md` §5.1 draws the nuisance), the SD of its logarithm exactly (0.117
+/// for ±20 %, 0.0173 for ±3 %). Read as a 95 % range (SD ln(1 + tol/2), 0.095 for
+/// ±20 %) the Gaussian term held each value tighter than the spread it stands for.
+pub fn tolerance_sd(tol: f64) -> f64 {
+    let (a, b) = (1.0 - tol, 1.0 + tol);
+    // ∫ ln x dx = x ln x − x, ∫ ln² x dx = x (ln² x − 2 ln x + 2).
+    let m1 = |x: f64| x * x.ln() - x;
+    let m2 = |x: f64| x * (x.ln().powi(2) - 2.0 * x.ln() + 2.0);
+    let mean = (m1(b) - m1(a)) / (b - a);
+    let square = (m2(b) - m2(a)) / (b - a);
+    (square - mean * mean).max(0.0).sqrt()
+}
 
 /// The least factor by which a named effect must shrink the flagged phase's gap [S]
 /// issue 33 ("a candidate that shrinks the flagged gap less than 2× is never named";
@@ -225,8 +232,9 @@ struct Setting {
     effect: Option<ActionEffect>,
     /// Per fitted run: release height (m), clock offset (s).
     runs: Vec<(f64, f64)>,
-    /// Factors on values the calibration holds at the file's (moved within their makers'
-    /// tolerance by the refit on every run, see [`tolerance_of`]): path, factor.
+    /// Factors on values the calibration holds at the file's (moved under their makers'
+    /// tolerance by the refit on every run, up to twice it, see [`tolerance_of`]): path,
+    /// factor.
     tweak: Vec<(String, f64)>,
 }
 
@@ -346,19 +354,20 @@ pub struct KeyDriveDiagnosis {
     /// Every candidate tried.
     pub candidates: Vec<KeyCandidate>,
     /// Whose values `calibrated`, `at_bound` and `tolerated` are: `baseline`, or the id of
-    /// the effect the report shows (named, the best of an ambiguity, or a partial
-    /// explanation's).
+    /// the effect the report shows (named, the best of an ambiguity, or, with a held-out
+    /// run, a partial explanation's: its refit on every run).
     pub values_of: String,
-    /// The calibrated values of the model `values_of` names.
+    /// The calibrated values of the model `values_of` names (with its effect's, as
+    /// `effects.ID.NAME`, when they come from the refit on every run).
     pub calibrated: BTreeMap<String, f64>,
     /// The values calibrated on the rise alone (the frames before the string), the trusted
     /// phase.
     pub rise_calibrated: BTreeMap<String, f64>,
     /// Calibrated values at the edge of their search range.
     pub at_bound: Vec<String>,
-    /// Values the calibration holds at the file's, each moved within its makers'
-    /// tolerance ([`tolerance_of`]) by the refit on every run: path, factor on the file's
-    /// value. Empty without a held-out run.
+    /// Values the calibration holds at the file's, each moved under its makers' tolerance
+    /// ([`tolerance_of`], searched to twice it) by the refit on every run: path, factor on
+    /// the file's value. Empty without a held-out run.
     pub tolerated: BTreeMap<String, f64>,
     /// The probability of moves as large as `tolerated`'s, the tolerances read as uniform
     /// spreads; below [`MOVED_P_MIN`] the model does not explain the data.
@@ -1054,7 +1063,7 @@ impl<'a> Problem<'a> {
         let physics = free.len();
         let sds: Vec<f64> = tolerances
             .iter()
-            .map(|(_, tol)| (1.0 + TOLERANCE_SD * tol).ln())
+            .map(|(_, tol)| tolerance_sd(*tol))
             .collect();
         for (path, tol) in tolerances {
             free.push(FreeParam::log(
@@ -1194,7 +1203,7 @@ impl<'a> Problem<'a> {
 /// How far a joint refit moved the values held at the file's within their tolerances.
 #[derive(Clone, Debug)]
 struct Moved {
-    /// The sum of their squared moves over their SDs ([`TOLERANCE_SD`]).
+    /// The sum of their squared moves over their SDs ([`tolerance_sd`]).
     distance2: f64,
     /// How many.
     dof: usize,
@@ -2280,10 +2289,12 @@ pub fn diagnose_key_drive(
             }
         )
     });
-    let after_eval: &[(Vec<f64>, Simulated)] = match shown.and_then(|b| tried[b].eval.as_ref()) {
-        Some(e) => e,
-        None => &base_eval,
-    };
+    // The model shown and its every run (the baseline's when no candidate is shown).
+    let (shown, after_eval): (Option<usize>, &[(Vec<f64>, Simulated)]) =
+        match shown.and_then(|b| tried[b].eval.as_ref().map(|e| (b, e))) {
+            Some((b, e)) => (Some(b), e),
+            None => (None, &base_eval),
+        };
     let after_setting = chosen.map_or(&baseline.setting, |b| &tried[b].fitted.setting);
     let shown_setting = shown.map_or(&baseline.setting, |b| &tried[b].fitted.setting);
     let mut phases = Vec::new();
@@ -2343,6 +2354,13 @@ pub fn diagnose_key_drive(
     let mut calibrated = BTreeMap::new();
     for ((name, _), v) in CALIBRATED.iter().zip(values_of.cal) {
         calibrated.insert(name.to_string(), v);
+    }
+    if joint.is_some()
+        && let Some(e) = &values_of.effect
+    {
+        for (p, v) in e.spec.params.iter().zip(&e.values) {
+            calibrated.insert(format!("effects.{}.{}", e.spec.id, p.name), *v);
+        }
     }
     for (r, (h, off)) in problem.fit_runs().zip(&values_of.runs) {
         calibrated.insert(format!("{}.release_height_m", r.id), *h);

@@ -107,14 +107,9 @@ pub fn post_check_gap(d: &KeyDriveDiagnosis) -> Option<(f64, f64)> {
     Some((q(&|p| p.before_rms_m), q(&|p| p.after_rms_m)))
 }
 
-/// What the calibrated values are: with a held-out run, those of one refit on every run
-/// with the values held at the file's free within their tolerance; as a paragraph (HTML
-/// when `html`).
-fn tolerated_text(d: &KeyDriveDiagnosis, html: bool) -> String {
-    let Some(p) = d.tolerated_p else {
-        return String::new();
-    };
-    let model = if d.values_of == "baseline" {
+/// The model whose values the report gives ([`KeyDriveDiagnosis::values_of`]), in words.
+pub fn model_of(d: &KeyDriveDiagnosis) -> String {
+    if d.values_of == "baseline" {
         "the baseline".to_string()
     } else if d.decision == "partly_explained" {
         format!(
@@ -123,19 +118,30 @@ fn tolerated_text(d: &KeyDriveDiagnosis, html: bool) -> String {
         )
     } else {
         format!("the baseline with {}", d.values_of)
+    }
+}
+
+/// What the calibrated values are: with a held-out run, those of one refit on every run
+/// with the values held at the file's free within their tolerance; as a paragraph (HTML
+/// when `html`).
+fn tolerated_text(d: &KeyDriveDiagnosis, html: bool) -> String {
+    let Some(p) = d.tolerated_p else {
+        return String::new();
     };
+    let model = model_of(d);
     let text = format!(
         "The values of {model}, refitted once on every run, fitted and held out (each \
          held-out run's release and clock free), with the {} values the calibration holds \
          at the file's free under their makers' tolerance (friction and contact stiffness \
-         ±20 %, masses ±3 %, each read as a uniform spread; searched to twice it): how the \
-         model is judged on a run it was not fitted to. The moves' probability, all \
-         together: p = {} (below {} the model does not explain the data).",
+         ±20 %, masses ±3 %, each read as a uniform spread; searched from 1/(1 + 2 tol) \
+         to 1 + 2 tol times the file's): how the model is judged on a run it was not \
+         fitted to. The moves' probability, all together: p = {} (below {} the model does \
+         not explain the data; one value beyond its tolerance does not reject it alone).",
         d.tolerated.len(),
-        if p >= 0.01 {
+        if p >= 0.1 {
             format!("{p:.2}")
         } else {
-            format!("{p:.1e}")
+            format!("{p:.2e}")
         },
         super::key_diagnose::MOVED_P_MIN
     );
@@ -146,11 +152,17 @@ fn tolerated_text(d: &KeyDriveDiagnosis, html: bool) -> String {
     }
 }
 
-/// A tolerated value's tolerance, and whether the refit moved it beyond (`factor` on the
-/// file's value).
+/// Whether the refit moved a tolerated value beyond its tolerance (`factor` on the file's
+/// value outside 1 ± tol).
+pub fn beyond_tolerance(path: &str, factor: f64) -> bool {
+    super::key_diagnose::tolerance_of(path, 1.0)
+        .is_some_and(|tol| !(1.0 - tol - 1e-9..=1.0 + tol + 1e-9).contains(&factor))
+}
+
+/// A tolerated value's tolerance, and whether the refit moved it beyond.
 fn tolerance_note(path: &str, factor: f64) -> String {
     match super::key_diagnose::tolerance_of(path, 1.0) {
-        Some(tol) if factor.ln().abs() > (1.0 + tol).ln() + 1e-9 => {
+        Some(tol) if beyond_tolerance(path, factor) => {
             format!("tolerance ±{:.0} %, beyond it", 100.0 * tol)
         }
         Some(tol) => format!("tolerance ±{:.0} %", 100.0 * tol),
@@ -187,7 +199,8 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     if !d.at_bound.is_empty() {
         let _ = writeln!(
             s,
-            "**Warning:** {} ended at the edge of its search range.\n",
+            "**Warning:** in {}, {} ended at the edge of its search range.\n",
+            model_of(d),
             d.at_bound.join(", ")
         );
     }
@@ -396,7 +409,8 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     if !d.at_bound.is_empty() {
         let _ = writeln!(
             s,
-            "<p><b>Warning:</b> {} ended at the edge of the search range.</p>",
+            "<p><b>Warning:</b> in {}, {} ended at the edge of the search range.</p>",
+            escape(&model_of(d)),
             escape(&d.at_bound.join(", "))
         );
     }
@@ -503,7 +517,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             let _ = writeln!(
                 s,
                 "<tr{}><td><code>{}</code></td><td class=\"num\">×{v:.3}</td><td>{}</td></tr>",
-                if note.contains("beyond") {
+                if beyond_tolerance(k, *v) {
                     " class=\"beyond\""
                 } else {
                     ""

@@ -2003,29 +2003,6 @@ pub fn clean(case_id: &str, seed: u64, options: &GenOptions) -> Result<Clean, St
     })
 }
 
-/// How visible case `case_id`'s effect is at `seed` before any model meets it: the RMS,
-/// over every run, marker, coordinate and frame, of its clean film's difference from the
-/// same action without the effect (`none` at the seed: the same nuisance, camera and
-/// heights), in the camera's noise SDs. Below about 1 the data cannot show the effect at
-/// all; well above, a `none` means the calibration's free values took it up.
-pub fn visibility(case_id: &str, seed: u64, options: &GenOptions) -> Result<f64, String> {
-    let with = clean(case_id, seed, options)?;
-    let without = clean("none", seed, options)?;
-    let (mut sum, mut n) = (0.0, 0usize);
-    for (a, b) in with.runs.iter().zip(&without.runs) {
-        for (ta, tb) in a.frames.iter().zip(&b.frames) {
-            for (p, q) in ta.iter().zip(tb) {
-                sum += (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
-                n += 2;
-            }
-        }
-    }
-    if n == 0 {
-        return Err(format!("case {case_id}, seed {seed}: no frames"));
-    }
-    Ok((sum / n as f64).sqrt() / with.camera.sigma_m)
-}
-
 // ---------------------------------------------------------------------------------------
 // Tracking noise and writing
 // ---------------------------------------------------------------------------------------
