@@ -2382,9 +2382,13 @@ pub fn diagnose_key_drive(
         })
         .into_iter()
         .collect();
+    // Without a refit on every run, the named effect's values are those of the fit on
+    // the fitted runs (as `effects` gives them, with their intervals).
     for e in &effects {
         for (name, v) in &e.params {
-            calibrated.insert(format!("effects.{}.{name}", e.id), *v);
+            calibrated
+                .entry(format!("effects.{}.{name}", e.id))
+                .or_insert(*v);
         }
     }
     let mut traces = Vec::new();
