@@ -49,7 +49,9 @@ use mbs_identify::work::{StageClock, StageWork, WorkCounter};
 use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
-use super::action_effects::{ACTION_EFFECTS, ActionEffect, action_effect_spec, marker_body_at};
+use super::action_effects::{
+    ACTION_EFFECTS, ActionEffect, action_effect_spec, file_values, marker_body_at,
+};
 use super::data_check::{DataCheck, Run, dataset_error, noise_floor, observations, run_residuals};
 use super::diagnose::{
     AMBIGUITY_BIC, DELTA_BIC_MAX, EFFECT_SIZE_MIN, IDENTIFIABLE_REL_SD, NamedEffect, Progress,
@@ -1971,16 +1973,22 @@ pub fn diagnose_key_drive(
                 100.0 * EFFECT_SIZE_MIN
             ));
         }
-        let strength = values[0];
-        let null = spec.params[0].null.unwrap_or(0.0);
-        // The strength follows the back-check's friction in the candidate's fit.
-        let sd = fitted
-            .fit
-            .sd
-            .get(RISE_HELD.len())
-            .copied()
-            .unwrap_or(f64::NAN);
-        let rel = sd / (strength - null).abs().max(1e-300);
+        // How well the fit tells the effect from the action as the file has it: of the
+        // parameters that leave the action as the file's at their file value (the
+        // strength, a felt's restitution and exponent), the one farthest from it in its
+        // SDs; a shape alone (a place, a damping ratio) changes nothing. The effect's
+        // values follow the back-check's two calibrated values in the candidate's fit.
+        let rel = file_values(spec, problem.params)
+            .iter()
+            .zip(&values)
+            .enumerate()
+            .filter_map(|(j, (null, v))| {
+                let null = (*null)?;
+                let sd = fitted.fit.sd.get(RISE_HELD.len() + j).copied()?;
+                let rel = sd / (v - null).abs().max(1e-300);
+                Some(if rel.is_nan() { f64::INFINITY } else { rel })
+            })
+            .fold(f64::INFINITY, f64::min);
         for (p, v) in spec.params.iter().zip(&values) {
             if !(p.range[0]..=p.range[1]).contains(v) {
                 fails.push(format!(
