@@ -125,7 +125,18 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
                 out.push(("compliance_rad_n_m", 1.0 / k));
             }
         }
-        "keybed_felt_p3" | "knuckle_felt_hc" => {
+        "keybed_felt_p3" => {
+            // The same felt law: its exponent and restitution, and its stiffness as the
+            // library's factor at the punching's working compression (0.5 mm), where the
+            // truth's force is its ratio at 1 mm times 0.5^(p − 2).
+            if let (Some(p), Some(e), Some(ratio)) = (get("p"), get("e"), get("force_ratio_at_1mm"))
+            {
+                out.push(("p", p));
+                out.push(("e", e));
+                out.push(("k_scale", ratio * 0.5f64.powf(p - 2.0)));
+            }
+        }
+        "knuckle_felt_hc" => {
             if let Some(p) = get("p") {
                 out.push(("p", p));
             }
