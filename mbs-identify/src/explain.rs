@@ -78,8 +78,9 @@ pub struct Window {
     pub t1_s: f64,
 }
 
-/// One run's residuals, in the order they were whitened (marker by marker, frame by
-/// frame), and its phases.
+/// One run's residuals, in the order they were whitened (marker by marker, each axis's
+/// frames in time order: a coordinate is a stretch over which time runs forward, which
+/// the whiteness test takes about its own mean), and its phases.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunResiduals {
     /// The run's id.
