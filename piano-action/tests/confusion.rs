@@ -173,6 +173,7 @@ fn short() -> GenOptions {
     GenOptions {
         duration_s: 0.15,
         heights: truths::Heights::FittedOnly,
+        ..GenOptions::default()
     }
 }
 
