@@ -443,7 +443,8 @@ fn dump_clean_frames() {
 }
 
 /// Writes the full dataset of case `$TRUTH_CASE` at seed `$TRUTH_SEED` (both runs, 0.3 s)
-/// into `$TRUTH_OUT`, its truth into `$TRUTH_OUT.truth.json`.
+/// into `$TRUTH_OUT`, its truth into `$TRUTH_OUT.truth.json`, simulated at the relative
+/// tolerance `$TRUTH_RTOL` (by default [`truths::RELATIVE_TOLERANCE`]).
 #[test]
 #[ignore = "a tool: writes one dataset"]
 fn write_dataset() {
@@ -454,7 +455,14 @@ fn write_dataset() {
         .unwrap_or(SEED);
     let out = PathBuf::from(std::env::var("TRUTH_OUT").unwrap_or_else(|_| "truth_dataset".into()));
     let truth = out.with_extension("truth.json");
-    let record = truths::generate(&case, seed, &out, &truth, &GenOptions::default())
-        .unwrap_or_else(|e| panic!("{e}"));
+    let options = GenOptions {
+        relative_tolerance: std::env::var("TRUTH_RTOL")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(truths::RELATIVE_TOLERANCE),
+        ..GenOptions::default()
+    };
+    let record =
+        truths::generate(&case, seed, &out, &truth, &options).unwrap_or_else(|e| panic!("{e}"));
     eprintln!("{}: {} ({})", out.display(), record.case, record.expected);
 }
