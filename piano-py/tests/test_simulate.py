@@ -241,6 +241,10 @@ def test_ctrl_c_stops_a_simulation():
     p = pa.Params()
     p.set("numerics.friction_regularization_m_s", 1e-12)
     p.set("numerics.pivot_friction_regularization_rad_s", 1e-12)
+    # A shell's background job (`cmd &`) starts with SIGINT ignored, and Python then
+    # installs no handler for it: Ctrl-C could not reach it, nor interrupt_main.
+    import signal
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(0.2, _thread.interrupt_main)
     timer.start()
     try:
@@ -250,5 +254,6 @@ def test_ctrl_c_stops_a_simulation():
                         p)
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     # Nothing is left behind: the next run is as before.
     assert pa.simulate(SCENARIOS / "struck_forte.toml").strikes
