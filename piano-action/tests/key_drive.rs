@@ -307,7 +307,8 @@ fn replaying_a_key_drive_reproduces_the_markers() {
 /// A synthetic truth is the physics to well under the noise: the same dataset (key bent,
 /// seed 1, both drops, 0.3 s; the noise drawn alike) synthesised from a file whose
 /// integrator tolerances are a hundred times tighter differs by a tenth of the declared
-/// noise at most. (At the file's own 1e-3 its fitted drop's head was 228 µm off.)
+/// noise at most (a convergence self-check: the synthesiser against itself). (At the
+/// file's own 1e-3 its fitted drop's head was 228 µm off.)
 #[test]
 fn a_synthetic_truth_is_the_physics_not_the_integrators_error() {
     use piano_action::identify::action_effects::ActionEffect;
