@@ -1259,6 +1259,26 @@ impl Moved {
         self.p() < MOVED_P_MIN
     }
 
+    /// The values (calibrated or held at the file's within a tolerance) that ended at the
+    /// edge of their search range, as `path value` or `path ×factor`; `None` when none
+    /// did. Under the makers' tolerance read as a uniform spread, a held value at twice
+    /// it has no probability at all, whatever the χ² over the twenty moves says (the
+    /// key's balance-pin friction at ×1.40 for a truth of ×6.7 passed at p 0.04 and the
+    /// baseline was called enough: the independent study's `key_pin_friction`, seed 1).
+    fn at_edge(&self) -> Option<String> {
+        let edge: Vec<String> = self
+            .at_bound
+            .iter()
+            .filter_map(|name| self.values.iter().find(|(n, _, _)| n == name))
+            .map(|(name, _, v)| match name.strip_suffix(" (factor)") {
+                Some(path) => format!("{path} ×{v:.2}"),
+                None if (1e-2..1e4).contains(&v.abs()) => format!("{name} {v:.3}"),
+                None => format!("{name} {v:.3e}"),
+            })
+            .collect();
+        (!edge.is_empty()).then(|| edge.join(", "))
+    }
+
     /// The tolerated value moved farthest, as `path ×factor`.
     fn farthest(&self) -> String {
         self.values
@@ -1312,14 +1332,20 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
         .collect();
     let mut check = check_noise(&runs, &names, &NoiseCheckOptions::default());
     // Every run explained with one action, but one its makers would not hold to?
-    if let Some(m) = eval.iter().find_map(|(_, s)| s.moved.as_ref())
-        && m.too_far()
-    {
+    let moved = eval.iter().find_map(|(_, s)| s.moved.as_ref());
+    if let Some(m) = moved.filter(|m| m.too_far()) {
         check.fail_also(format!(
             "every run explained only with values held at the file's moved beyond their \
              tolerance ({}; p {:.1e} < {MOVED_P_MIN})",
             m.farthest(),
             m.p()
+        ));
+    }
+    // Or one that wants a value beyond the edge of its search range?
+    if let Some(edge) = moved.and_then(Moved::at_edge) {
+        check.fail_also(format!(
+            "every run explained only with {edge} at the edge of its search range (a \
+             held value's is twice its makers' tolerance): the runs ask for more"
         ));
     }
     check
@@ -2672,6 +2698,46 @@ fn onset_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A refit that leaves one tolerated value at the edge of its search range is refused
+    /// even where the χ² over the twenty moves passes (the independent study's
+    /// `key_pin_friction`, seed 1: the balance-pin friction at ×1.40, the rest near 1).
+    #[test]
+    fn a_value_at_the_edge_of_its_search_is_no_explanation() {
+        let tolerated: Vec<(String, f64)> = (0..20)
+            .map(|i| (format!("contacts.c{i}.k (factor)"), 1.05))
+            .chain([("key.pivot_friction_n_m (factor)".to_string(), 1.4)])
+            .collect();
+        let moved = |at_bound: Vec<String>| Moved {
+            distance2: tolerated
+                .iter()
+                .map(|(_, f)| (f.ln() / tolerance_sd(0.2)).powi(2))
+                .sum(),
+            dof: tolerated.len(),
+            values: tolerated
+                .iter()
+                .map(|(n, f)| (n.clone(), 1.0, *f))
+                .chain([("felt_k_scale".to_string(), 1.0, 1.35)])
+                .collect(),
+            at_bound,
+            held: Vec::new(),
+            setting: Setting {
+                cal: [1.0; 5],
+                effect: None,
+                runs: Vec::new(),
+                tweak: Vec::new(),
+            },
+        };
+        let at = moved(vec!["key.pivot_friction_n_m (factor)".into()]);
+        assert!(!at.too_far(), "the χ² alone refuses it: p {}", at.p());
+        assert_eq!(
+            at.at_edge().as_deref(),
+            Some("key.pivot_friction_n_m ×1.40")
+        );
+        let cal = moved(vec!["felt_k_scale".into()]);
+        assert_eq!(cal.at_edge().as_deref(), Some("felt_k_scale 1.350"));
+        assert_eq!(moved(Vec::new()).at_edge(), None);
+    }
 
     /// A fit's evaluation that moves only a run's clock films the simulation it already
     /// has: the same predictions, bit for bit, as simulating again, and one simulation
