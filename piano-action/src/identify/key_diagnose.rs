@@ -1261,11 +1261,13 @@ impl Moved {
 
     /// The values (calibrated or held at the file's within a tolerance) that ended at the
     /// edge of their search range, as `path value` or `path ×factor`; `None` when none
-    /// did. Under the makers' tolerance read as a uniform spread, a held value at twice
-    /// it has no probability at all, whatever the χ² over the twenty moves says (the
-    /// key's balance-pin friction at ×1.40 for a truth of ×6.7 passed at p 0.04 and the
-    /// baseline was called enough: the independent study's `key_pin_friction`, seed 1).
+    /// did; four named, the rest counted. Under the makers' tolerance read as a uniform
+    /// spread, a held value at twice it has no probability at all, whatever the χ² over
+    /// the twenty moves says (the key's balance-pin friction at ×1.40 for a truth of ×6.7
+    /// passed at p 0.04 and the baseline was called enough: the independent study's
+    /// `key_pin_friction`, seed 1).
     fn at_edge(&self) -> Option<String> {
+        const SHOWN: usize = 4;
         let edge: Vec<String> = self
             .at_bound
             .iter()
@@ -1276,7 +1278,15 @@ impl Moved {
                 None => format!("{name} {v:.3e}"),
             })
             .collect();
-        (!edge.is_empty()).then(|| edge.join(", "))
+        match edge.len() {
+            0 => None,
+            n if n <= SHOWN => Some(edge.join(", ")),
+            n => Some(format!(
+                "{n} values ({} and {} more)",
+                edge[..SHOWN].join(", "),
+                n - SHOWN
+            )),
+        }
     }
 
     /// The tolerated value moved farthest, as `path ×factor`.
@@ -1344,8 +1354,8 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
     // Or one that wants a value beyond the edge of its search range?
     if let Some(edge) = moved.and_then(Moved::at_edge) {
         check.fail_also(format!(
-            "every run explained only with {edge} at the edge of its search range (a \
-             held value's is twice its makers' tolerance): the runs ask for more"
+            "every run explained only with {edge} at the edge of the search (a held \
+             value's edge is twice its makers' tolerance): the runs ask for more"
         ));
     }
     check
@@ -2737,6 +2747,18 @@ mod tests {
         let cal = moved(vec!["felt_k_scale".into()]);
         assert_eq!(cal.at_edge().as_deref(), Some("felt_k_scale 1.350"));
         assert_eq!(moved(Vec::new()).at_edge(), None);
+        let many = moved(
+            (0..6)
+                .map(|i| format!("contacts.c{i}.k (factor)"))
+                .collect(),
+        );
+        assert_eq!(
+            many.at_edge().as_deref(),
+            Some(
+                "6 values (contacts.c0.k ×1.05, contacts.c1.k ×1.05, contacts.c2.k ×1.05, \
+                 contacts.c3.k ×1.05 and 2 more)"
+            )
+        );
     }
 
     /// A fit's evaluation that moves only a run's clock films the simulation it already
