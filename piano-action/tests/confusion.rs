@@ -436,16 +436,23 @@ fn a_partial_explanation_reports_the_values_it_had_to_move() {
         d.calibrated
             .contains_key("effects.key_flex.compliance_rad_n_m")
     );
-    // The value the summary names is one moved farthest (ties at a bound are equal).
+    // The value the summary names as moved beyond its tolerance is one moved farthest
+    // (ties at a bound are equal); the values at the edge of the search follow in a
+    // clause of their own.
     let farthest = d
         .tolerated
         .values()
         .map(|f| f.ln().abs())
         .fold(0.0, f64::max);
+    let clause = d
+        .summary
+        .split("moved beyond their tolerance (")
+        .nth(1)
+        .expect("the moves' clause");
     let named = d
         .tolerated
         .iter()
-        .find(|(k, _)| d.summary.contains(&format!("{k} ×")))
+        .find(|(k, _)| clause.starts_with(&format!("{k} ×")))
         .map(|(_, f)| f.ln().abs())
         .expect("a tolerated value named in the summary");
     assert!((named - farthest).abs() < 1e-9, "{named} vs {farthest}");
