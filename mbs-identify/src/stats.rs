@@ -103,8 +103,63 @@ pub fn chi2_sf(x: f64, k: f64) -> f64 {
     gamma_q(0.5 * k, 0.5 * x)
 }
 
+/// The standard deviation of component `i` of a Gaussian estimate with covariance `cov`
+/// when the components `given` are held at their values: √(Σᵢᵢ − Σᵢₛ Σₛₛ⁻¹ Σₛᵢ) (the
+/// Schur complement). How well a strength is known at a fitted place, where the place
+/// and the strength trade along a ridge. `None` when an index is out of range, `i` is
+/// among `given`, `Σₛₛ` is not positive definite or the result not a finite, non-negative
+/// number.
+pub fn conditional_sd(cov: &nalgebra::DMatrix<f64>, i: usize, given: &[usize]) -> Option<f64> {
+    let n = cov.nrows();
+    if cov.ncols() != n || i >= n || given.iter().any(|&g| g >= n || g == i) {
+        return None;
+    }
+    let mut var = cov[(i, i)];
+    if !given.is_empty() {
+        let m = given.len();
+        let ss = nalgebra::DMatrix::from_fn(m, m, |p, q| cov[(given[p], given[q])]);
+        let si = nalgebra::DVector::from_fn(m, |p, _| cov[(given[p], i)]);
+        let solved = ss.cholesky()?.solve(&si);
+        var -= si.dot(&solved);
+    }
+    (var.is_finite() && var >= 0.0).then(|| var.sqrt())
+}
+
 #[cfg(test)]
 mod tests {
+
+    /// Two components of correlation ρ: the first's SD given the second is σ √(1 − ρ²);
+    /// given nothing, σ; a component given itself, or a singular block, is refused.
+    #[test]
+    fn a_component_held_leaves_the_schur_complement() {
+        use nalgebra::DMatrix;
+        let (s1, s2, rho) = (2.0, 0.5, 0.9);
+        let cov = DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                s1 * s1,
+                rho * s1 * s2,
+                0.0,
+                rho * s1 * s2,
+                s2 * s2,
+                0.0,
+                0.0,
+                0.0,
+                1.0,
+            ],
+        );
+        let given = conditional_sd(&cov, 0, &[1]).expect("defined");
+        assert!((given - s1 * (1.0 - rho * rho).sqrt()).abs() < 1e-12);
+        // An uncorrelated component held changes nothing.
+        let alone = conditional_sd(&cov, 0, &[2]).expect("defined");
+        assert!((alone - s1).abs() < 1e-12);
+        assert!((conditional_sd(&cov, 0, &[]).expect("defined") - s1).abs() < 1e-12);
+        assert_eq!(conditional_sd(&cov, 0, &[0]), None);
+        assert_eq!(conditional_sd(&cov, 3, &[]), None);
+        let singular = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 0.0]);
+        assert_eq!(conditional_sd(&singular, 0, &[1]), None);
+    }
     use super::*;
 
     #[test]
