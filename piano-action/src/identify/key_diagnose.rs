@@ -2097,10 +2097,13 @@ pub fn diagnose_key_drive(
             .iter()
             .filter_map(|&(i, null, v)| {
                 let null = null?;
-                let sd = match &fitted.fit.covariance {
-                    Some(cov) => conditional_sd(cov, i, &shape)?,
-                    None => fitted.fit.sd.get(i).copied()?,
-                };
+                // (the SD over every shape where the held block is not invertible)
+                let sd = fitted
+                    .fit
+                    .covariance
+                    .as_ref()
+                    .and_then(|cov| conditional_sd(cov, i, &shape))
+                    .or_else(|| fitted.fit.sd.get(i).copied())?;
                 let rel = sd / (v - null).abs().max(1e-300);
                 Some(if rel.is_nan() { f64::INFINITY } else { rel })
             })
