@@ -127,6 +127,7 @@ pub fn conditional_sd(cov: &nalgebra::DMatrix<f64>, i: usize, given: &[usize]) -
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     /// Two components of correlation ρ: the first's SD given the second is σ √(1 − ρ²);
     /// given nothing, σ; a component given itself, or a singular block, is refused.
@@ -160,7 +161,6 @@ mod tests {
         let singular = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 0.0]);
         assert_eq!(conditional_sd(&singular, 0, &[1]), None);
     }
-    use super::*;
 
     #[test]
     fn ln_gamma_matches_factorials_and_half_integers() {
