@@ -2326,10 +2326,15 @@ pub fn diagnose_key_drive(
             (
                 "partly_explained".to_string(),
                 format!(
-                    "{} brings the gap at {:.0}–{:.0} ms (the flagged {} and what follows it \
-                     within 10 ms) from {:.0} to {:.0} µm ({x:.1}×; noise floor {:.0} µm), \
-                     but {}{}",
+                    "{}{} brings the gap at {:.0}–{:.0} ms (the flagged {} and what follows \
+                     it within 10 ms) from {:.0} to {:.0} µm ({x:.1}×; noise floor {:.0} µm), \
+                     but {}",
                     tried[b].spec.id,
+                    if ambiguous_with.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" (as could {})", ambiguous_with.join(" or "))
+                    },
                     flag_window.0 * 1e3,
                     flag_window.1.min(r0.times.last().copied().unwrap_or(0.0)) * 1e3,
                     flag_phase.name,
@@ -2337,11 +2342,6 @@ pub fn diagnose_key_drive(
                     window_rms(r0, &tried[b].fit_res[0], flag_window.0, flag_window.1, None) * 1e6,
                     sigma * 1e6,
                     left.join("; "),
-                    if ambiguous_with.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" (as do {})", ambiguous_with.join(", "))
-                    }
                 ),
             )
         }
