@@ -6,15 +6,15 @@
 //! | id | transformation | parameters (null) |
 //! |---|---|---|
 //! | `key_flex` | `split_body` of the key `cut_m` (20 mm typically) behind the balance pivot: the back arm (capstan, back-check, back rail) on a torsion spring | `compliance_rad_n_m` (0), `zeta`, `cut_m`, `reach` |
-//! | `shank_flex` | `split_body` of the hammer `root_m` along the shank (the head's root, 110 mm, typically): the head (crown, tail) on a torsion spring | `compliance_rad_n_m` (0), `zeta`, `root_m`, `reach` |
+//! | `shank_flex` | `split_body` of the hammer `root_m` along the shank (the head's root, 110 mm, typically): the head (crown, tail) on a torsion spring, its mass what the whole hammer leaves after the shank up to the hinge | `compliance_rad_n_m` (0), `zeta`, `root_m` |
 //! | `backcheck_compliance` | `mount_compliant` of the back-check's face on a wire rooted on the key: a body `backcheck` on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
 //! | `keybed_felt` | `swap_law` of the front-rail punching: its stiffness scaled, its restitution set, its exponent | `k_scale` (1), `e`, `p` |
 //! | `felt_hysteresis` | `swap_law` of the knuckle's felt: its restitution (loading against unloading) shifted, its exponent | `de` (0), `p` |
 //! | `knuckle_friction` | `swap_friction` of the jack–knuckle contact: its friction coefficient raised | `dmu` (0) |
 //!
 //! A flex's damping is given by its ratio ζ: c = 2 ζ √(k I), I the moving part's inertia
-//! about its new joint; how far out the moving part's mass sits, its `reach`, is a factor
-//! on the estimate. The geometry of each cut and mount (where the key bends, the
+//! about its new joint; how far out the key's back arm carries its mass, its `reach`, is a
+//! factor on the estimate. The geometry of each cut and mount (where the key bends, the
 //! head's mass) is estimated [D] and documented on its constant.
 
 use mbs_identify::{EffectParam, EffectSpec};
@@ -95,7 +95,6 @@ pub const SHANK_FLEX: EffectSpec = EffectSpec {
             log_scale: false,
             screen: &[0.04, 0.075, 0.11],
         },
-        REACH,
     ],
     confusable_with: &["backcheck_compliance", "key_flex"],
     discriminating_experiment: "track two points on the hammer, the head and the middle of \
@@ -251,19 +250,18 @@ const ZETA: EffectParam = EffectParam {
     screen: &[],
 };
 
-/// How far out a flex's moving part carries its mass [D]: its centre of mass's distance
-/// from the hinge and its radius of gyration, both as a factor on the estimate (the key's
-/// back arm a uniform stick, the hammer's head lumped at [`HEAD_COM_M`]); its inertia
-/// about the hinge goes as the factor's square, its mass stays. The file gives the whole
-/// part's mass properties, not how they share out about a hinge: a back arm that carries
-/// the capstan and the back-check on its wire (6 g up to 70 mm above the stick) has its
-/// centre 10–15 % further out than a uniform stick and 20 % more inertia about a hinge
-/// 60 mm behind the pivot; a head whose centre sits 10 mm further along than the lumped
-/// estimate, 10–30 % more about a hinge in the shank. With the estimate alone, a key bent
-/// 62 mm behind the pivot (the independent truths' `key_flex_far`, seed 1) was followed
-/// to the noise only with the let-off button's felt pushed to its tolerance's edge and its
+/// How far out the key's back arm carries its mass [D]: its centre of mass's distance
+/// from the hinge and its radius of gyration, both as a factor on the estimate (a uniform
+/// stick); its inertia about the hinge goes as the factor's square, its mass stays. The
+/// file gives the whole key's mass properties, not how they share out about a hinge: a
+/// back arm that carries the capstan and the back-check on its wire (6 g up to 70 mm above
+/// the stick) has its centre 10–15 % further out than a uniform stick and 20 % more
+/// inertia about a hinge 60 mm behind the pivot. With the estimate alone, a key bent 62 mm
+/// behind the pivot (the independent truths' `key_flex_far`, seed 1) was followed to the
+/// noise only with the let-off button's felt pushed to its tolerance's edge and its
 /// residuals not white; with 1.2 times the inertia, named. The range allows a third less
-/// and half as much again.
+/// and half as much again. (The shank's flex has none: its head is what the whole hammer
+/// leaves after the shank, so the file's measured hammer fixes it.)
 const REACH: EffectParam = EffectParam {
     name: "reach",
     unit: "",
@@ -348,17 +346,10 @@ impl ActionEffect {
 /// the arm's length (the stick's wood is even).
 const KEY_BACK_MASS_SHARE: f64 = 0.27;
 /// The shank's mass per length (kg/m) [D]: hornbeam, 8 mm across (about 700 kg/m³ over
-/// 50 mm²: 0.035 kg/m), less for its taper: 0.025.
+/// 50 mm²: 0.035 kg/m), less for its taper: 0.025; a shank alone weighs about 3 g over its
+/// 120 mm (James Ellis, CAUT 2003-November/010193 [V]: shank-only strike weight 1.3–1.7 g
+/// at 130 mm; `action_layout.md`).
 const SHANK_KG_M: f64 = 0.025;
-/// Where the shank meets the head, along the shank from the flange pin (m) [D]: the
-/// moulding spans 115–140 mm around the 132 mm strike point.
-const HEAD_ROOT_M: f64 = 0.11;
-/// The head's share of the hammer's mass [D]: felt and moulding some 8 g of the 11.74 g.
-const HEAD_MASS_SHARE: f64 = 0.68;
-/// The head's centre of mass in the hammer frame (m) [D]: the moulding's middle.
-const HEAD_COM_M: [f64; 2] = [0.12, 0.014];
-/// The head's inertia about its centre of mass (kg·m²) [D]: 8 g over about 50 × 25 mm.
-const HEAD_INERTIA_KG_M2: f64 = 2.0e-6;
 /// The back-check's mass (kg) [M]: wire, wooden head and felt.
 const BACKCHECK_MASS_KG: f64 = 0.006;
 /// Its inertia about its centre of mass (kg·m²) [D]: 6 g over a 30 × 20 mm head.
@@ -531,27 +522,39 @@ pub fn apply(
                     inertia: mass * length * length / 12.0,
                 }
             } else {
-                let head = MassProps {
-                    mass: HEAD_MASS_SHARE * whole.mass,
-                    com: HEAD_COM_M,
-                    inertia: HEAD_INERTIA_KG_M2,
+                // The head and the shank beyond the cut: what the whole hammer (the file's
+                // measured mass, centre and inertia) leaves after the shank from the flange
+                // pin to the cut, a rod on the shank's axis. The shank is the part a
+                // geometry estimate gets right; the head holds whatever else the whole
+                // measures (an estimate of the head instead left the piece at the flange
+                // with a 2 g body's centre 30 mm off the shank and a 90 mm radius of
+                // gyration).
+                let m = SHANK_KG_M * cut.at[0];
+                let shank = MassProps {
+                    mass: m,
+                    com: [0.5 * cut.at[0], 0.0],
+                    inertia: m * cut.at[0] * cut.at[0] / 12.0,
                 };
-                // A cut inside the shank takes the shank's piece beyond it as a rod.
-                let piece = (HEAD_ROOT_M - cut.at[0]).max(0.0);
-                if piece > 0.0 {
-                    let m = SHANK_KG_M * piece;
-                    head.plus(&MassProps {
-                        mass: m,
-                        com: [cut.at[0] + 0.5 * piece, 0.0],
-                        inertia: m * piece * piece / 12.0,
-                    })
-                } else {
-                    head
+                let distal = whole.minus(&shank);
+                if !(distal.mass > 0.0 && distal.inertia > 0.0 && distal.com[0] > cut.at[0]) {
+                    return Err(bad(
+                        spec.id,
+                        format!(
+                            "the hammer's mass properties leave no head beyond {} m: {distal:?}",
+                            cut.at[0]
+                        ),
+                    ));
                 }
+                distal
             };
             // Its reach: the centre's distance from the hinge and the radius of gyration
             // scaled alike.
-            let reach = value(spec, values, "reach")?;
+            // The head has none: the whole hammer's measured mass properties fix it.
+            let reach = if spec.params.iter().any(|p| p.name == "reach") {
+                value(spec, values, "reach")?
+            } else {
+                1.0
+            };
             if !(reach > 0.0 && reach.is_finite()) {
                 return Err(bad(spec.id, format!("reach {reach} must be positive")));
             }
@@ -715,13 +718,14 @@ mod tests {
         }
     }
 
-    /// A flex's reach carries its moving part's mass further out: its centre's distance
+    /// The key flex's reach carries its back arm's mass further out: its centre's distance
     /// from the hinge by the factor, its inertia about the hinge by its square, its mass
     /// and the whole body's mass unchanged.
     #[test]
     fn a_flexs_reach_moves_its_parts_mass_out() {
         let (params, m) = grand();
-        for (spec, new_body) in [(&KEY_FLEX, "key_back_arm"), (&SHANK_FLEX, "hammer_head")] {
+        {
+            let (spec, new_body) = (&KEY_FLEX, "key_back_arm");
             let part = |reach: f64| {
                 let mut values: Vec<f64> = spec.params.iter().map(|p| p.typical).collect();
                 let j = spec
@@ -744,6 +748,66 @@ mod tests {
             assert!((m2 - m1).abs() < 1e-15, "{}", spec.id);
             assert!((r2 / r1 - 1.2).abs() < 1e-9, "{}: {}", spec.id, r2 / r1);
             assert!((i2 / i1 - 1.44).abs() < 1e-9, "{}: {}", spec.id, i2 / i1);
+        }
+    }
+
+    /// A bent shank leaves at the flange what a shank is there: the piece up to the hinge
+    /// keeps a rod's mass (its length times the shank's mass per length), its centre on
+    /// the shank's axis half way, a rod's inertia; the head takes the rest, so the hammer's
+    /// mass, centre and inertia about its pin are the file's. (An estimate of the head
+    /// instead left a 2 g piece at the flange with its centre 30 mm off the shank and a
+    /// 93 mm radius of gyration, and a head that did not follow an independent bent shank.)
+    #[test]
+    fn a_bent_shank_leaves_a_shank_at_the_flange() {
+        let (params, m) = grand();
+        let whole = MassProps::of(
+            m.bodies
+                .iter()
+                .find(|b| b.name == "hammer")
+                .expect("hammer"),
+        );
+        for root in [0.035, 0.04, 0.075, 0.11, 0.115] {
+            let t = apply(&m, &SHANK_FLEX, &[0.15, 0.05, root], &params).expect("split");
+            let find = |n: &str| t.bodies.iter().find(|b| b.name == n).expect(n).clone();
+            let (near, head) = (find("hammer"), find("hammer_head"));
+            let rod = SHANK_KG_M * root;
+            assert!(
+                (near.mass - rod).abs() < 1e-9 * rod,
+                "{root}: {} kg",
+                near.mass
+            );
+            assert!(
+                (near.com[0] - 0.5 * root).abs() < 1e-9 && near.com[1].abs() < 1e-9,
+                "{root}: {:?}",
+                near.com
+            );
+            let rod_inertia = rod * root * root / 12.0;
+            assert!(
+                (near.inertia - rod_inertia).abs() < 1e-6 * rod_inertia,
+                "{root}: {} against {rod_inertia}",
+                near.inertia
+            );
+            // The two parts, the head seen from the pin, are the whole hammer.
+            let head_in_hammer = MassProps {
+                mass: head.mass,
+                com: [head.com[0] + root, head.com[1]],
+                inertia: head.inertia,
+            };
+            let sum = MassProps::of(&near).plus(&head_in_hammer);
+            assert!((sum.mass - whole.mass).abs() < 1e-12, "{root}");
+            assert!(
+                (sum.com[0] - whole.com[0]).abs() < 1e-9
+                    && (sum.com[1] - whole.com[1]).abs() < 1e-9,
+                "{root}: {:?} against {:?}",
+                sum.com,
+                whole.com
+            );
+            assert!(
+                (sum.inertia - whole.inertia).abs() < 1e-9 * whole.inertia,
+                "{root}: {} against {}",
+                sum.inertia,
+                whole.inertia
+            );
         }
     }
 

@@ -944,7 +944,8 @@ pub fn diagnose(
             }
             if x < super::key_diagnose::SHRINK_MIN {
                 left.push(format!(
-                    "it shrinks the flagged phase's gap only {x:.1}× (needs {}×)",
+                    "it shrinks the flagged phase's gap only {} (needs {}×)",
+                    super::key_diagnose::shrink_text(x),
                     super::key_diagnose::SHRINK_MIN
                 ));
             }

@@ -219,6 +219,20 @@ pub fn tolerance_sd(tol: f64) -> f64 {
 /// `identification.md` §5.5).
 pub const SHRINK_MIN: f64 = 2.0;
 
+/// A shrink factor as a summary prints it: one decimal, two where one would round a factor
+/// short of [`SHRINK_MIN`] up to it ("1.96×, needs 2×", not "2.0×, needs 2×").
+pub fn shrink_text(x: f64) -> String {
+    if x < SHRINK_MIN
+        && format!("{x:.1}")
+            .parse::<f64>()
+            .is_ok_and(|r| r >= SHRINK_MIN)
+    {
+        format!("{x:.2}×")
+    } else {
+        format!("{x:.1}×")
+    }
+}
+
 /// The most accepted steps of a screening point's refit of what the rise cannot see
 /// [D]: two parameters from a near start.
 pub const SCREEN_ITERATIONS: usize = 4;
@@ -2317,7 +2331,8 @@ pub fn diagnose_key_drive(
             let mut left = Vec::new();
             if x < SHRINK_MIN {
                 left.push(format!(
-                    "it shrinks the flagged phase's gap only {x:.1}× (needs {SHRINK_MIN}×)"
+                    "it shrinks the flagged phase's gap only {} (needs {SHRINK_MIN}×)",
+                    shrink_text(x)
                 ));
             }
             if let Some(c) = check.filter(|c| !c.explained) {
@@ -2327,7 +2342,7 @@ pub fn diagnose_key_drive(
                 "partly_explained".to_string(),
                 format!(
                     "{}{} brings the gap at {:.0}–{:.0} ms (the flagged {} and what follows \
-                     it within 10 ms) from {:.0} to {:.0} µm ({x:.1}×; noise floor {:.0} µm), \
+                     it within 10 ms) from {:.0} to {:.0} µm ({}; noise floor {:.0} µm), \
                      but {}",
                     tried[b].spec.id,
                     if ambiguous_with.is_empty() {
@@ -2340,6 +2355,7 @@ pub fn diagnose_key_drive(
                     flag_phase.name,
                     window_rms(r0, &base_eval[f0].0, flag_window.0, flag_window.1, None) * 1e6,
                     window_rms(r0, &tried[b].fit_res[0], flag_window.0, flag_window.1, None) * 1e6,
+                    shrink_text(x),
                     sigma * 1e6,
                     left.join("; "),
                 ),
@@ -2770,6 +2786,16 @@ mod tests {
     /// A refit that leaves one tolerated value at the edge of its search range is refused
     /// even where the χ² over the twenty moves passes (the independent study's
     /// `key_pin_friction`, seed 1: the balance-pin friction at ×1.40, the rest near 1).
+    /// A factor short of the rule never prints as the rule's own number.
+    #[test]
+    fn a_shrink_short_of_the_rule_never_reads_as_it() {
+        assert_eq!(shrink_text(1.96), "1.96×");
+        assert_eq!(shrink_text(1.94), "1.9×");
+        assert_eq!(shrink_text(2.0), "2.0×");
+        assert_eq!(shrink_text(2.04), "2.0×");
+        assert_eq!(shrink_text(49.0), "49.0×");
+    }
+
     #[test]
     fn a_value_at_the_edge_of_its_search_is_no_explanation() {
         let tolerated: Vec<(String, f64)> = (0..20)
