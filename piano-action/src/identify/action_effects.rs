@@ -71,7 +71,10 @@ pub const KEY_FLEX: EffectSpec = EffectSpec {
 /// range allows 10 times stiffer and 80 times softer. The typical (visible) value, 0.15
 /// rad/(N·m) (a thin shank, 6 times softer than that estimate), is where the gap after
 /// the check's catch holds several noise floors under nuisance: at 0.05 the calibrated
-/// baseline misses it there by 1.4 floors only (measured, seed 1).
+/// baseline misses it there by 1.4 floors only (measured, seed 1, with the head lumped
+/// before it was made the whole hammer less the shank). The head is what the file's whole
+/// hammer leaves after the shank up to the hinge ([`SHANK_KG_M`]): the measured whole is
+/// the surest thing known of it.
 pub const SHANK_FLEX: EffectSpec = EffectSpec {
     id: "shank_flex",
     summary: "the hammer shank bends: the head turns on a torsion spring at its root",
