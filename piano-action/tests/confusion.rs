@@ -114,7 +114,8 @@ fn diagnose_case(
 /// Where a truth's effect has a value the library's parameter stands for (the same
 /// quantity of the same form): each such parameter and its true value. A flex at one
 /// place: its compliance (the truth's 1/k) and place; a felt's exponent; a friction's
-/// coefficient step. Forms the library has no parameter for (three hinges, a slide) have
+/// coefficient step; a shank bent at two places, its whole compliance and the share at
+/// the head's root. Forms the library has no parameter for (three hinges, a slide) have
 /// none.
 fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, f64)> {
     let get = |k: &str| effect.get(k).copied();
@@ -123,6 +124,15 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
         "key_flex_far" | "shank_flex_mid" => {
             if let Some(k) = get("k_n_m_per_rad") {
                 out.push(("compliance_rad_n_m", 1.0 / k));
+            }
+        }
+        "shank_flex_two" => {
+            // Two hinges, the second near the head's root where the library's sits: the
+            // whole compliance and the share of it there.
+            if let (Some(k1), Some(k2)) = (get("k1_n_m_per_rad"), get("k2_n_m_per_rad")) {
+                let whole = 1.0 / k1 + 1.0 / k2;
+                out.push(("compliance_rad_n_m", whole));
+                out.push(("head_share", (1.0 / k2) / whole));
             }
         }
         "keybed_felt_p3" => {
