@@ -74,10 +74,13 @@ pub const KEY_FLEX: EffectSpec = EffectSpec {
 /// baseline misses it there by 1.4 floors only (measured, seed 1, with the head lumped
 /// before it was made the whole hammer less the shank). The head is what the file's whole
 /// hammer leaves after the shank up to the hinge ([`SHANK_KG_M`]): the measured whole is
-/// the surest thing known of it.
+/// the surest thing known of it. A `head_share` of the compliance goes on a second hinge
+/// at the head's root ([`HEAD_ROOT_M`]): one hinge turns the shank's middle and the head
+/// by one angle, two bend them apart.
 pub const SHANK_FLEX: EffectSpec = EffectSpec {
     id: "shank_flex",
-    summary: "the hammer shank bends: the head turns on a torsion spring at its root",
+    summary: "the hammer shank bends: the head turns on a torsion spring along the shank \
+        (and on a second at its root, for its share)",
     params: &[
         EffectParam {
             name: "compliance_rad_n_m",
@@ -842,6 +845,16 @@ mod tests {
     use super::*;
     use crate::ModelKind;
 
+    /// The file's whole hammer's mass properties.
+    fn whole_hammer(m: &Mechanism) -> MassProps {
+        MassProps::of(
+            m.bodies
+                .iter()
+                .find(|b| b.name == "hammer")
+                .expect("hammer"),
+        )
+    }
+
     fn grand() -> (ActionParams, Mechanism) {
         let params = ActionParams::reference();
         let m = crate::describe::grand_mechanism(&params, ModelKind::Double, None).expect("grand");
@@ -916,12 +929,7 @@ mod tests {
     #[test]
     fn a_bent_shank_leaves_a_shank_at_the_flange() {
         let (params, m) = grand();
-        let whole = MassProps::of(
-            m.bodies
-                .iter()
-                .find(|b| b.name == "hammer")
-                .expect("hammer"),
-        );
+        let whole = whole_hammer(&m);
         for root in [0.035, 0.04, 0.075, 0.11, 0.115] {
             let t = apply(&m, &SHANK_FLEX, &[0.15, 0.05, root], &params).expect("split");
             let find = |n: &str| t.bodies.iter().find(|b| b.name == n).expect(n).clone();
@@ -975,12 +983,7 @@ mod tests {
     #[test]
     fn a_shank_bent_at_two_places_shares_its_compliance() {
         let (params, m) = grand();
-        let whole = MassProps::of(
-            m.bodies
-                .iter()
-                .find(|b| b.name == "hammer")
-                .expect("hammer"),
-        );
+        let whole = whole_hammer(&m);
         let (c, root, share) = (0.15, 0.05, 0.4);
         let t = apply(&m, &SHANK_FLEX, &[c, 0.05, root, share], &params).expect("split");
         t.build_with(&crate::describe::PianoExtensions)
