@@ -20,6 +20,10 @@
 //!   `λ ← λ·max(1/3, 1 − (2ρ − 1)³)` with `ρ` the ratio of actual to predicted decrease,
 //!   on rejection `λ ← λ·ν, ν ← 2ν`.
 //!
+//! With [`LmOptions::secant`] an accepted step updates `J` by Broyden's rank-one formula
+//! instead of new finite differences, until the update stops being trusted (§3.4 of the
+//! same; see the option).
+//!
 //! At the optimum the covariance is `s² (JᵀJ)⁻¹` with `s² = S / (N − k)`, mapped from
 //! internal to physical units by the delta method.
 
@@ -138,6 +142,18 @@ pub struct LmOptions {
     /// is the larger of the two.
     #[serde(default)]
     pub score_batches: usize,
+    /// Broyden's rank-one update of the Jacobian after an accepted step instead of new
+    /// finite differences (default false): the secant Levenberg–Marquardt method of
+    /// Madsen, Nielsen & Tingleff (2004, §3.4), for fits with many parameters whose
+    /// Jacobian costs most of their evaluations. The finite differences are taken again
+    /// whenever the updated Jacobian is not trusted: at the start, after a step whose
+    /// actual decrease was under a quarter of the predicted one, after a rejected trial
+    /// (instead of more damping), after [`SECANT_UPDATES_MAX`] updates in a row, and
+    /// before any stop on the cost tolerance or the step limit is accepted, so that a fit
+    /// stops, and reports its covariance, on a Jacobian of finite differences at its
+    /// optimum, as without it.
+    #[serde(default)]
+    pub secant: bool,
 }
 
 fn default_covariance() -> bool {
@@ -155,6 +171,7 @@ impl Default for LmOptions {
             threads: thread::available_parallelism().map_or(2, |n| n.get()),
             covariance: true,
             score_batches: 0,
+            secant: false,
         }
     }
 }
@@ -210,6 +227,8 @@ pub struct LmFit {
     pub iterations: usize,
     /// Residual-function calls.
     pub evaluations: usize,
+    /// Jacobians taken by finite differences (each `k` or `2k` of the evaluations).
+    pub jacobians: usize,
     /// Whether the solver converged ([`Stop::converged`]).
     pub converged: bool,
     /// Why it stopped.
@@ -267,6 +286,14 @@ const DAMPING_FLOOR: f64 = 1e-9;
 const SINGULAR_RCOND: f64 = 1e-12;
 /// `at_bound`: within this fraction of the bound range.
 const AT_BOUND: f64 = 0.01;
+/// With [`LmOptions::secant`], the most secant updates of the Jacobian in a row before
+/// finite differences are taken again [D].
+pub const SECANT_UPDATES_MAX: usize = 10;
+/// With [`LmOptions::secant`], the least ratio of a step's actual to its predicted decrease
+/// after which the Jacobian is updated rather than taken again: Nielsen's damping already
+/// treats a step under a quarter as the model failing ([D], after Madsen et al. 2004
+/// §2.4).
+const SECANT_RHO_MIN: f64 = 0.25;
 
 /// Fits `params` by minimising the sum of squares of `residuals(x)` within the bounds.
 ///
@@ -312,6 +339,7 @@ where
         n: r.len(),
         options,
         evaluations: 1,
+        jacobians: 0,
     };
     let mut at = Point::new(x, z, r);
     if axes.is_empty() {
@@ -321,31 +349,95 @@ where
     let mut damping = Damping::new(axes.len());
     let mut accepted = 0;
     let mut pending: Option<Stop> = None;
+    // The Jacobian at `at` (none until taken), whether it is of finite differences there
+    // (rather than updated by secants), and the secant updates since it last was.
+    let mut jac: Option<Vec<Vec<f64>>> = None;
+    let mut fresh = false;
+    let mut updates = 0;
     loop {
+        let stopping = pending.is_some() || accepted >= options.max_iterations;
         // Without a covariance wanted, a fit that stops here needs no Jacobian.
-        if !options.covariance && (pending.is_some() || accepted >= options.max_iterations) {
+        if !options.covariance && stopping {
             let stop = pending.unwrap_or(Stop::MaxIterations);
             return Ok(problem.finish(at, None, accepted, stop));
         }
-        // The Jacobian at every accepted point: the next step's, or the covariance's.
-        let jac = problem.jacobian(&at)?;
-        if let Some(stop) = pending {
-            return Ok(problem.finish(at, Some(&jac), accepted, stop));
+        // The Jacobian at every accepted point: the next step's, or the covariance's; of
+        // finite differences unless a secant update is trusted.
+        if jac.is_none() || (!fresh && (stopping || updates >= SECANT_UPDATES_MAX)) {
+            jac = Some(problem.jacobian(&at)?);
+            fresh = true;
+            updates = 0;
         }
-        let model = Model::new(&jac, &at, &axes, &mut damping);
+        let Some(j) = jac.as_deref() else {
+            unreachable!("the Jacobian is taken above");
+        };
+        if let Some(stop) = pending {
+            return Ok(problem.finish(at, Some(j), accepted, stop));
+        }
+        let model = Model::new(j, &at, &axes, &mut damping);
         if let Some(stop) = model.converged(options.cost_tolerance * at.rss) {
-            return Ok(problem.finish(at, Some(&jac), accepted, stop));
+            if fresh {
+                return Ok(problem.finish(at, Some(j), accepted, stop));
+            }
+            // An updated Jacobian's claim is checked on finite differences.
+            jac = None;
+            continue;
         }
         if accepted >= options.max_iterations {
-            return Ok(problem.finish(at, Some(&jac), accepted, Stop::MaxIterations));
+            return Ok(problem.finish(at, Some(j), accepted, Stop::MaxIterations));
         }
-        match problem.trials(&at, &model, &mut damping)? {
-            Trial::Accepted { next, small } => {
+        match problem.trials(&at, &model, &mut damping, fresh)? {
+            Trial::Accepted {
+                next,
+                small,
+                rho,
+                step,
+            } => {
+                let trusted = rho.is_some_and(|rho| rho >= SECANT_RHO_MIN);
+                match jac.as_mut() {
+                    Some(j) if options.secant && trusted => {
+                        broyden(j, &step, &at.r, &next.r);
+                        // A small step judged on an updated Jacobian is judged again on
+                        // finite differences at the next point.
+                        pending = (small && fresh).then_some(Stop::CostTolerance);
+                        fresh = false;
+                        updates += 1;
+                    }
+                    _ => {
+                        jac = None;
+                        pending = small.then_some(Stop::CostTolerance);
+                    }
+                }
                 at = next;
                 accepted += 1;
-                pending = small.then_some(Stop::CostTolerance);
             }
-            Trial::Stop(stop) => return Ok(problem.finish(at, Some(&jac), accepted, stop)),
+            Trial::Stale => jac = None,
+            Trial::Stop(stop) if !fresh && stop != Stop::Stationary => jac = None,
+            Trial::Stop(stop) => return Ok(problem.finish(at, Some(j), accepted, stop)),
+        }
+    }
+}
+
+/// Broyden's rank-one update of `J` (columns) for the step `s` (units of typical) that
+/// took the residuals from `r0` to `r1`: `J ← J + (Δr − J s) sᵀ / sᵀs`, the least change
+/// of `J` that makes it reproduce the step (Madsen, Nielsen & Tingleff 2004, eq. 3.30).
+fn broyden(jac: &mut [Vec<f64>], s: &[f64], r0: &[f64], r1: &[f64]) {
+    let ss = dot(s, s);
+    if !(ss > 0.0 && ss.is_finite()) {
+        return;
+    }
+    let miss: Vec<f64> = (0..r0.len())
+        .map(|l| {
+            let predicted: f64 = jac.iter().zip(s).map(|(c, si)| c[l] * si).sum();
+            (r1[l] - r0[l]) - predicted
+        })
+        .collect();
+    for (c, &si) in jac.iter_mut().zip(s) {
+        if si != 0.0 {
+            let w = si / ss;
+            for (cl, m) in c.iter_mut().zip(&miss) {
+                *cl += w * m;
+            }
         }
     }
 }
@@ -481,8 +573,16 @@ impl Model {
 /// The outcome of the trials at one Jacobian.
 enum Trial {
     /// A lower cost at `next`; `small` if both the actual and the predicted decrease were
-    /// within the cost tolerance.
-    Accepted { next: Point, small: bool },
+    /// within the cost tolerance; `rho` the ratio of the actual to the predicted decrease
+    /// (none if the model predicted none); `step` the step taken, in units of typical.
+    Accepted {
+        next: Point,
+        small: bool,
+        rho: Option<f64>,
+        step: Vec<f64>,
+    },
+    /// A trial on a Jacobian updated by secants was rejected: take finite differences.
+    Stale,
     /// No trial is worth evaluating, or the damping is exhausted.
     Stop(Stop),
 }
@@ -590,6 +690,8 @@ struct Problem<'a, F> {
     n: usize,
     options: &'a LmOptions,
     evaluations: usize,
+    /// Jacobians of finite differences taken.
+    jacobians: usize,
 }
 
 impl<F> Problem<'_, F>
@@ -659,12 +761,14 @@ where
 
     /// Trial steps from `at` with the model's Jacobian, more damped after each rejection
     /// (a failed evaluation, a non-finite residual or a cost not lower), until one lowers
-    /// the cost.
+    /// the cost; on a Jacobian not `fresh` (updated by secants) the first rejection
+    /// returns [`Trial::Stale`] instead.
     fn trials(
         &mut self,
         at: &Point,
         model: &Model,
         damping: &mut Damping,
+        fresh: bool,
     ) -> Result<Trial, FitError> {
         let axes = self.axes;
         let k = axes.len();
@@ -700,10 +804,19 @@ where
                 let next = Point::new(x, z, r);
                 if next.rss < at.rss {
                     let actual = at.rss - next.rss;
-                    damping.accept((predicted > 0.0).then(|| actual / predicted));
+                    let rho = (predicted > 0.0).then(|| actual / predicted);
+                    damping.accept(rho);
                     let small = actual <= tolerance && predicted <= tolerance;
-                    return Ok(Trial::Accepted { next, small });
+                    return Ok(Trial::Accepted {
+                        next,
+                        small,
+                        rho,
+                        step: s,
+                    });
                 }
+            }
+            if !fresh {
+                return Ok(Trial::Stale);
             }
             if !damping.reject() {
                 return Ok(Trial::Stop(Stop::NoProgress));
@@ -715,6 +828,7 @@ where
     /// residuals `r`). Steps stay in the box: one-sided inward at a bound (3-point when
     /// central); a failed side is replaced by the other.
     fn jacobian(&mut self, at: &Point) -> Result<Vec<Vec<f64>>, FitError> {
+        self.jacobians += 1;
         let (x, z, r) = (&at.x, &at.z, &at.r);
         let k = z.len();
         let axes = self.axes;
@@ -858,6 +972,7 @@ where
             at_bound,
             iterations,
             evaluations: self.evaluations,
+            jacobians: self.jacobians,
             converged: stop.converged(),
             stop,
         }
