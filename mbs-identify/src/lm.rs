@@ -5,7 +5,8 @@
 //! already standardised residuals (a simulation compared with a measurement, N of them)
 //! and `x` a handful of parameters. A residual evaluation is expensive (a simulation), so
 //! the method counts them: a Jacobian costs k (forward) or 2k (central) evaluations, run on
-//! several threads, and a rejected trial costs one evaluation and no Jacobian.
+//! several threads, and a rejected trial costs one evaluation and no Jacobian (with secant
+//! updates, one on an updated Jacobian costs a Jacobian of finite differences as well).
 //!
 //! Each parameter moves in its internal coordinate `z` (`z = x`, or `z = ln x` on a log
 //! scale), measured in units of its `typical` size: `u = z / typical`. One iteration:
@@ -21,8 +22,8 @@
 //!   on rejection `λ ← λ·ν, ν ← 2ν`.
 //!
 //! With [`LmOptions::secant`] an accepted step updates `J` by Broyden's rank-one formula
-//! instead of new finite differences, until the update stops being trusted (§3.4 of the
-//! same; see the option).
+//! instead of new finite differences, while the update is trusted (§3.5 of the same; see
+//! the option).
 //!
 //! At the optimum the covariance is `s² (JᵀJ)⁻¹` with `s² = S / (N − k)`, mapped from
 //! internal to physical units by the delta method.
@@ -143,15 +144,16 @@ pub struct LmOptions {
     #[serde(default)]
     pub score_batches: usize,
     /// Broyden's rank-one update of the Jacobian after an accepted step instead of new
-    /// finite differences (default false): the secant Levenberg–Marquardt method of
-    /// Madsen, Nielsen & Tingleff (2004, §3.4), for fits with many parameters whose
-    /// Jacobian costs most of their evaluations. The finite differences are taken again
-    /// whenever the updated Jacobian is not trusted: at the start, after a step whose
-    /// actual decrease was under a quarter of the predicted one, after a rejected trial
-    /// (instead of more damping), after [`SECANT_UPDATES_MAX`] updates in a row, and
-    /// before any stop on the cost tolerance or the step limit is accepted, so that a fit
-    /// stops, and reports its covariance, on a Jacobian of finite differences at its
-    /// optimum, as without it.
+    /// finite differences (default false): after the secant Levenberg–Marquardt method of
+    /// Madsen, Nielsen & Tingleff (2004, §3.5), for fits with many parameters whose
+    /// Jacobian costs most of their evaluations. The update is kept only after a step
+    /// whose actual decrease was at least [`SECANT_RHO_MIN`] of the predicted one and that
+    /// moved some parameter by at least `fd_relative_step` of its typical size (a shorter
+    /// step sees the residuals' noise); finite differences are taken again otherwise,
+    /// after a rejected trial on an updated Jacobian (instead of more damping), after
+    /// [`SECANT_UPDATES_MAX`] updates in a row, and before any stop is accepted, so that
+    /// a fit stops, and reports its covariance, on a Jacobian of finite differences at its
+    /// optimum, as without it. The damping's scale is taken from finite differences only.
     #[serde(default)]
     pub secant: bool,
 }
@@ -227,7 +229,8 @@ pub struct LmFit {
     pub iterations: usize,
     /// Residual-function calls.
     pub evaluations: usize,
-    /// Jacobians taken by finite differences (each `k` or `2k` of the evaluations).
+    /// Jacobians taken by finite differences (each `k` or `2k` of the evaluations, and one
+    /// more for a side that failed and was tried on the other).
     pub jacobians: usize,
     /// Whether the solver converged ([`Stop::converged`]).
     pub converged: bool,
@@ -290,10 +293,10 @@ const AT_BOUND: f64 = 0.01;
 /// finite differences are taken again [D].
 pub const SECANT_UPDATES_MAX: usize = 10;
 /// With [`LmOptions::secant`], the least ratio of a step's actual to its predicted decrease
-/// after which the Jacobian is updated rather than taken again: Nielsen's damping already
-/// treats a step under a quarter as the model failing ([D], after Madsen et al. 2004
+/// after which the Jacobian is updated rather than taken again [D]: the ratio below which
+/// Marquardt-type damping rules take the linear model for a poor one (Madsen et al. 2004,
 /// §2.4).
-const SECANT_RHO_MIN: f64 = 0.25;
+pub const SECANT_RHO_MIN: f64 = 0.25;
 
 /// Fits `params` by minimising the sum of squares of `residuals(x)` within the bounds.
 ///
@@ -374,7 +377,7 @@ where
         if let Some(stop) = pending {
             return Ok(problem.finish(at, Some(j), accepted, stop));
         }
-        let model = Model::new(j, &at, &axes, &mut damping);
+        let model = Model::new(j, &at, &axes, &mut damping, fresh);
         if let Some(stop) = model.converged(options.cost_tolerance * at.rss) {
             if fresh {
                 return Ok(problem.finish(at, Some(j), accepted, stop));
@@ -393,26 +396,29 @@ where
                 rho,
                 step,
             } => {
-                let trusted = rho.is_some_and(|rho| rho >= SECANT_RHO_MIN);
+                // The Jacobian is updated only after a step it predicted well, longer than
+                // a finite difference's (a shorter one sees the residuals' noise), and not
+                // after a small step judged on an update. A small step stops the fit only
+                // if judged on finite differences; one judged on an update is judged again
+                // on finite differences at the next point.
+                let trusted = options.secant
+                    && rho.is_some_and(|rho| rho >= SECANT_RHO_MIN)
+                    && step.iter().any(|v| v.abs() >= options.fd_relative_step)
+                    && (fresh || !small);
+                pending = (small && fresh).then_some(Stop::CostTolerance);
                 match jac.as_mut() {
-                    Some(j) if options.secant && trusted => {
+                    Some(j) if trusted => {
                         broyden(j, &step, &at.r, &next.r);
-                        // A small step judged on an updated Jacobian is judged again on
-                        // finite differences at the next point.
-                        pending = (small && fresh).then_some(Stop::CostTolerance);
                         fresh = false;
                         updates += 1;
                     }
-                    _ => {
-                        jac = None;
-                        pending = small.then_some(Stop::CostTolerance);
-                    }
+                    _ => jac = None,
                 }
                 at = next;
                 accepted += 1;
             }
             Trial::Stale => jac = None,
-            Trial::Stop(stop) if !fresh && stop != Stop::Stationary => jac = None,
+            Trial::Stop(_) if !fresh => jac = None,
             Trial::Stop(stop) => return Ok(problem.finish(at, Some(j), accepted, stop)),
         }
     }
@@ -420,7 +426,8 @@ where
 
 /// Broyden's rank-one update of `J` (columns) for the step `s` (units of typical) that
 /// took the residuals from `r0` to `r1`: `J ← J + (Δr − J s) sᵀ / sᵀs`, the least change
-/// of `J` that makes it reproduce the step (Madsen, Nielsen & Tingleff 2004, eq. 3.30).
+/// of `J` (in the Frobenius norm) that makes it reproduce the step (Broyden 1965; Madsen,
+/// Nielsen & Tingleff 2004, §3.5).
 fn broyden(jac: &mut [Vec<f64>], s: &[f64], r0: &[f64], r1: &[f64]) {
     let ss = dot(s, s);
     if !(ss > 0.0 && ss.is_finite()) {
@@ -501,13 +508,23 @@ struct Model {
 }
 
 impl Model {
-    fn new(jac: &[Vec<f64>], at: &Point, axes: &[Axis], damping: &mut Damping) -> Self {
+    fn new(
+        jac: &[Vec<f64>],
+        at: &Point,
+        axes: &[Axis],
+        damping: &mut Damping,
+        fresh: bool,
+    ) -> Self {
         let k = jac.len();
         let a = gram(jac);
         let g: Vec<f64> = jac.iter().map(|c| dot(c, &at.r)).collect();
-        // D = running max of diag(A), floored relative to its largest entry.
-        for (running, i) in damping.running_diag.iter_mut().zip(0..k) {
-            *running = running.max(a[(i, i)]);
+        // D = running max of diag(A), floored relative to its largest entry; taken from
+        // Jacobians of finite differences only (an update that overshoots would damp its
+        // parameter for the rest of the fit).
+        if fresh {
+            for (running, i) in damping.running_diag.iter_mut().zip(0..k) {
+                *running = running.max(a[(i, i)]);
+            }
         }
         let largest = damping.running_diag.iter().fold(0.0_f64, |m, &v| m.max(v));
         let d = damping
@@ -775,6 +792,9 @@ where
         let tolerance = self.options.cost_tolerance * at.rss;
         loop {
             let Some(delta) = model.step(damping.lambda) else {
+                if !fresh {
+                    return Ok(Trial::Stale);
+                }
                 damping.lambda = (10.0 * damping.lambda).max(LAMBDA_MIN);
                 if damping.lambda > LAMBDA_MAX {
                     return Ok(Trial::Stop(Stop::NoProgress));
@@ -1107,4 +1127,33 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 fn sum_sq(r: &[f64]) -> f64 {
     dot(r, r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The update makes the Jacobian reproduce the step exactly, and leaves a column whose
+    /// parameter did not move (held at a bound) as it was.
+    #[test]
+    fn broydens_update_reproduces_the_step() {
+        let mut jac = vec![
+            vec![1.0, 2.0, 3.0],
+            vec![0.5, -1.0, 0.0],
+            vec![2.0, 0.0, 1.0],
+        ];
+        let s = [0.3, -0.2, 0.0];
+        let (r0, r1) = ([1.0, 1.0, 1.0], [1.4, 0.1, 2.0]);
+        let held = jac[2].clone();
+        broyden(&mut jac, &s, &r0, &r1);
+        for l in 0..3 {
+            let predicted: f64 = (0..3).map(|i| jac[i][l] * s[i]).sum();
+            assert!((predicted - (r1[l] - r0[l])).abs() < 1e-12, "row {l}");
+        }
+        assert_eq!(jac[2], held);
+        // A zero step changes nothing.
+        let before = jac.clone();
+        broyden(&mut jac, &[0.0; 3], &r0, &r1);
+        assert_eq!(jac, before);
+    }
 }

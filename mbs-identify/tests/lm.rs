@@ -533,6 +533,20 @@ fn with_independent_errors_the_sandwich_is_the_plain_interval() {
 /// Six bumps of known centres and unknown heights and widths (12 parameters, widths on a
 /// log scale), measured with noise, started a factor off.
 fn bumps_fit(seed: u64, options: &LmOptions) -> LmFit {
+    bumps_fit_from(seed, options, &[0.7, 0.45].repeat(6))
+}
+
+/// A plain fit of the bumps started at `values` and stopped before its first step: the
+/// covariance of finite differences there.
+fn refit_bumps_at(seed: u64, values: &[f64]) -> LmFit {
+    let options = LmOptions {
+        max_iterations: 0,
+        ..LmOptions::default()
+    };
+    bumps_fit_from(seed, &options, values)
+}
+
+fn bumps_fit_from(seed: u64, options: &LmOptions, start: &[f64]) -> LmFit {
     let centres = [1.0, 2.5, 4.0, 5.5, 7.0, 8.5];
     let heights = [1.0, 0.6, 1.4, 0.8, 1.2, 0.5];
     let widths = [0.4, 0.6, 0.3, 0.5, 0.7, 0.35];
@@ -549,8 +563,14 @@ fn bumps_fit(seed: u64, options: &LmOptions) -> LmFit {
         .collect();
     let mut params = Vec::new();
     for i in 0..6 {
-        params.push(FreeParam::linear(format!("a{i}"), 0.7, 0.0, 5.0, 0.1));
-        params.push(FreeParam::log(format!("w{i}"), 0.45, 0.05, 2.0));
+        params.push(FreeParam::linear(
+            format!("a{i}"),
+            start[2 * i],
+            0.0,
+            5.0,
+            0.1,
+        ));
+        params.push(FreeParam::log(format!("w{i}"), start[2 * i + 1], 0.05, 2.0));
     }
     let model = |x: &[f64]| {
         Ok(data
@@ -592,6 +612,17 @@ fn secant_updates_reach_the_same_optimum_on_fewer_evaluations() {
             );
         }
         assert!((secant.rss - plain.rss).abs() < 1e-3 * plain.rss);
+        // Its covariance is that of finite differences at its own optimum, to the bit's
+        // noise: a plain fit started there and stopped at once reports the same.
+        let there = refit_bumps_at(seed, &secant.values);
+        for i in 0..12 {
+            assert!(
+                (secant.sd[i] / there.sd[i] - 1.0).abs() < 1e-9,
+                "seed {seed}, param {i}: {} against {}",
+                secant.sd[i],
+                there.sd[i]
+            );
+        }
         eprintln!(
             "seed {seed}: plain {} evaluations, {} Jacobians; secant {}, {}",
             plain.evaluations, plain.jacobians, secant.evaluations, secant.jacobians

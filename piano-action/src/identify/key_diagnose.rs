@@ -904,10 +904,11 @@ impl<'a> Problem<'a> {
             fd_relative_step: FD_STEP,
             score_batches: SCORE_BATCHES,
             // Broyden's updates between Jacobians: on the shipped bending key, the whole
-            // library, 4866 evaluations became 3893 (the screening's 3128 2506, the
-            // refits' 686 469), the same decision and values within their intervals;
-            // the refit on every run gains little (its steps often predict their
-            // decrease poorly, and each such step takes finite differences again).
+            // library, 4866 evaluations became 3893 on 2b94d1d (screening 3128 -> 2506,
+            // refits 686 -> 469, the baseline's refit on every run 464 -> 366), the same
+            // decision and values within their intervals; the candidate's refit on every
+            // run gains little (its steps often gain far less than predicted, and each
+            // such step takes finite differences again).
             secant: true,
             ..LmOptions::default()
         }
