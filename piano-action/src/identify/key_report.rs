@@ -180,12 +180,8 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     for e in &d.effects {
         let _ = write!(s, "Effect `{}`:", e.id);
         for (name, v) in &e.params {
-            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
-            let _ = write!(
-                s,
-                " `{name}` = {v:.3e} (95 %: {:.3e} to {:.3e});",
-                ci[0], ci[1]
-            );
+            let ci = super::report::interval_text(e.ci95.get(name).copied());
+            let _ = write!(s, " `{name}` = {v:.3e} ({ci});");
         }
         s.push_str("\n\n");
     }
@@ -387,14 +383,8 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     for e in &d.effects {
         let _ = write!(s, "<p>Effect <code>{}</code>: ", escape(&e.id));
         for (name, v) in &e.params {
-            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
-            let _ = write!(
-                s,
-                "<code>{}</code> = {v:.3e} (95 %: {:.3e} to {:.3e}) ",
-                escape(name),
-                ci[0],
-                ci[1]
-            );
+            let ci = super::report::interval_text(e.ci95.get(name).copied());
+            let _ = write!(s, "<code>{}</code> = {v:.3e} ({ci}) ", escape(name));
         }
         s.push_str("</p>\n");
     }

@@ -97,12 +97,8 @@ pub fn markdown(d: &Diagnosis, dataset: &Path) -> String {
             e.id, e.location
         );
         for (name, v) in &e.params {
-            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
-            let _ = writeln!(
-                s,
-                "- `{name}` = {v:.3e} (95 %: {:.3e} to {:.3e})",
-                ci[0], ci[1]
-            );
+            let ci = interval_text(e.ci95.get(name).copied());
+            let _ = writeln!(s, "- `{name}` = {v:.3e} ({ci})");
         }
         s.push('\n');
     }
@@ -355,14 +351,8 @@ pub fn html(d: &Diagnosis, dataset: &Path) -> String {
             escape(&e.location)
         );
         for (name, v) in &e.params {
-            let ci = e.ci95.get(name).copied().unwrap_or([f64::NAN; 2]);
-            let _ = write!(
-                s,
-                "<code>{}</code> = {v:.3e} (95 %: {:.3e} to {:.3e}) ",
-                escape(name),
-                ci[0],
-                ci[1]
-            );
+            let ci = interval_text(e.ci95.get(name).copied());
+            let _ = write!(s, "<code>{}</code> = {v:.3e} ({ci}) ", escape(name));
         }
         s.push_str("</p>\n");
     }
@@ -645,4 +635,33 @@ pub(super) fn data_items(data: &super::data_check::DataCheck) -> String {
         );
     }
     s
+}
+
+/// A value's 95 % interval as the reports print it, or that it has none (a value set by
+/// a fit that gives no covariance, such as the refit on every run, or a singular one)
+/// rather than "NaN to NaN".
+pub(super) fn interval_text(ci: Option<[f64; 2]>) -> String {
+    match ci {
+        Some([lo, hi]) if lo.is_finite() && hi.is_finite() => {
+            format!("95 %: {lo:.3e} to {hi:.3e}")
+        }
+        _ => "no 95 % interval".to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::interval_text;
+
+    /// A value without an interval says so; one with an interval prints both ends.
+    #[test]
+    fn a_missing_interval_is_said_not_printed_as_nan() {
+        assert_eq!(
+            interval_text(Some([1e-3, 2e-3])),
+            "95 %: 1.000e-3 to 2.000e-3"
+        );
+        for missing in [None, Some([f64::NAN, f64::NAN]), Some([1.0, f64::NAN])] {
+            assert_eq!(interval_text(missing), "no 95 % interval");
+        }
+    }
 }
