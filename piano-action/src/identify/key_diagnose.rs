@@ -35,6 +35,7 @@
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -1038,15 +1039,19 @@ impl<'a> Problem<'a> {
         } else {
             0
         });
+        let fit_runs: Vec<&Run> = self.fit_runs().collect();
+        let busy = AtomicUsize::new(0);
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
             self.work.add_evaluation();
             let s = self.setting_of(start, x, stage);
+            let each = runs_side_by_side(self.threads, &busy, fit_runs.len(), |i| {
+                let (r, (h, off)) = (fit_runs[i], s.runs[i]);
+                self.predict_until(&recent, &s, (i, r), h, off, horizon)
+                    .map(|predicted| self.whitened_until(r, &predicted, horizon))
+            });
             let mut out = Vec::new();
-            for (i, (r, (h, off))) in self.fit_runs().zip(&s.runs).enumerate() {
-                let predicted = self
-                    .predict_until(&recent, &s, (i, r), *h, *off, horizon)
-                    .map_err(|e| e.to_string())?;
-                out.extend(self.whitened_until(r, &predicted, horizon));
+            for run in each {
+                out.extend(run.map_err(|e| e.to_string())?);
             }
             Ok(out)
         };
@@ -1186,15 +1191,19 @@ impl<'a> Problem<'a> {
                 .collect()
         };
         let recent = Recent::new((free.len() + 1) * self.runs.len());
+        let busy = AtomicUsize::new(0);
         let residuals = |x: &[f64]| -> std::result::Result<Vec<f64>, String> {
             self.work.add_evaluation();
             let t = setting_at(x);
+            let at = releases(&t, x);
+            let each = runs_side_by_side(self.threads, &busy, self.runs.len(), |i| {
+                let (r, (h, off)) = (&self.runs[i], at[i]);
+                self.predict_until(&recent, &t, (i, r), h, off, f64::INFINITY)
+                    .map(|predicted| self.whitened(r, &predicted))
+            });
             let mut out = Vec::new();
-            for (i, (r, (h, off))) in self.runs.iter().zip(releases(&t, x)).enumerate() {
-                let predicted = self
-                    .predict_until(&recent, &t, (i, r), h, off, f64::INFINITY)
-                    .map_err(|e| e.to_string())?;
-                out.extend(self.whitened(r, &predicted));
+            for run in each {
+                out.extend(run.map_err(|e| e.to_string())?);
             }
             out.extend(
                 x[physics..physics + n_tol]
@@ -1436,6 +1445,41 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
         ));
     }
     check
+}
+
+/// `each(i)` for the `n` runs of one evaluation of a fit, in order: side by side on
+/// their own threads when no other evaluation of the fit is under way (`busy` counts
+/// them: a trial step, which the fit waits for, rather than a Jacobian's column, whose
+/// neighbours already fill the cores) and the fit has `threads` to spare; one after the
+/// other otherwise. The results do not depend on it: each run's simulation is its own.
+fn runs_side_by_side<T: Send>(
+    threads: usize,
+    busy: &AtomicUsize,
+    n: usize,
+    each: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
+    struct Leave<'a>(&'a AtomicUsize);
+    impl Drop for Leave<'_> {
+        fn drop(&mut self) {
+            self.0.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+    let alone = busy.fetch_add(1, Ordering::SeqCst) == 0;
+    let _leave = Leave(busy);
+    if !alone || threads < 2 || n < 2 {
+        return (0..n).map(each).collect();
+    }
+    let each = &each;
+    std::thread::scope(|scope| {
+        let others: Vec<_> = (1..n).map(|i| scope.spawn(move || each(i))).collect();
+        let first = each(0);
+        std::iter::once(first)
+            .chain(others.into_iter().map(|h| {
+                h.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            }))
+            .collect()
+    })
 }
 
 /// Threads of the Jacobian of each of `tasks` fits run side by side on `width` cores:
@@ -2824,6 +2868,34 @@ fn onset_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A lone evaluation's runs go side by side, each on its own thread, their results in
+    /// the runs' order; with another evaluation of the fit under way (a Jacobian's
+    /// column), or one thread, they stay on the calling thread; the count of evaluations
+    /// under way is left as found.
+    #[test]
+    fn a_lone_evaluation_runs_its_runs_side_by_side() {
+        let here = std::thread::current().id();
+        let each = |i: usize| (i * 10, std::thread::current().id());
+        let busy = AtomicUsize::new(0);
+        let alone = runs_side_by_side(2, &busy, 3, each);
+        assert_eq!(alone.iter().map(|r| r.0).collect::<Vec<_>>(), [0, 10, 20]);
+        assert_eq!(alone[0].1, here);
+        assert!(alone[1..].iter().all(|r| r.1 != here));
+        assert_ne!(alone[1].1, alone[2].1);
+        assert_eq!(busy.load(Ordering::SeqCst), 0);
+        busy.store(1, Ordering::SeqCst);
+        let beside = runs_side_by_side(2, &busy, 3, each);
+        assert_eq!(beside.iter().map(|r| r.0).collect::<Vec<_>>(), [0, 10, 20]);
+        assert!(beside.iter().all(|r| r.1 == here));
+        assert_eq!(busy.load(Ordering::SeqCst), 1);
+        busy.store(0, Ordering::SeqCst);
+        assert!(
+            runs_side_by_side(1, &busy, 3, each)
+                .iter()
+                .all(|r| r.1 == here)
+        );
+    }
 
     /// A refit that leaves one tolerated value at the edge of its search range is refused
     /// even where the χ² over the twenty moves passes (the independent study's
