@@ -1447,17 +1447,19 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
     check
 }
 
-/// `each(i)` for the `n` runs of one evaluation of a fit, in order: side by side on
-/// their own threads when no other evaluation of the fit is under way (`busy` counts
-/// them: a trial step, which the fit waits for, rather than a Jacobian's column, whose
-/// neighbours already fill the cores) and the fit has `threads` to spare; one after the
-/// other otherwise. The results do not depend on it: each run's simulation is its own.
-fn runs_side_by_side<T: Send>(
+/// `each(i)` for the `n` runs of one evaluation of a fit, in order: side by side, runs
+/// 1.. on threads of their own, when no other evaluation of the fit is under way
+/// (`busy` counts them; mostly a trial step, which the fit waits for) and the fit has two
+/// threads or more; one after the other otherwise, stopping at the first failed run. A
+/// Jacobian's columns start together, so its first column may find itself alone and
+/// take threads for its runs too: a brief oversubscription, never a different value
+/// (each run's simulation is its own; which simulations the cache keeps may differ).
+fn runs_side_by_side<T: Send, E: Send>(
     threads: usize,
     busy: &AtomicUsize,
     n: usize,
-    each: impl Fn(usize) -> T + Sync,
-) -> Vec<T> {
+    each: impl Fn(usize) -> std::result::Result<T, E> + Sync,
+) -> Vec<std::result::Result<T, E>> {
     struct Leave<'a>(&'a AtomicUsize);
     impl Drop for Leave<'_> {
         fn drop(&mut self) {
@@ -1467,7 +1469,16 @@ fn runs_side_by_side<T: Send>(
     let alone = busy.fetch_add(1, Ordering::SeqCst) == 0;
     let _leave = Leave(busy);
     if !alone || threads < 2 || n < 2 {
-        return (0..n).map(each).collect();
+        let mut out = Vec::with_capacity(n);
+        for i in 0..n {
+            let r = each(i);
+            let failed = r.is_err();
+            out.push(r);
+            if failed {
+                break;
+            }
+        }
+        return out;
     }
     let each = &each;
     std::thread::scope(|scope| {
@@ -2875,26 +2886,49 @@ mod tests {
     /// under way is left as found.
     #[test]
     fn a_lone_evaluation_runs_its_runs_side_by_side() {
+        type Run = (usize, std::thread::ThreadId, usize);
         let here = std::thread::current().id();
-        let each = |i: usize| (i * 10, std::thread::current().id());
         let busy = AtomicUsize::new(0);
-        let alone = runs_side_by_side(2, &busy, 3, each);
+        // Each run sees its evaluation counted while it runs.
+        let each = |i: usize| -> std::result::Result<Run, ()> {
+            Ok((
+                i * 10,
+                std::thread::current().id(),
+                busy.load(Ordering::SeqCst),
+            ))
+        };
+        let ok = |v: Vec<std::result::Result<Run, ()>>| -> Vec<Run> {
+            v.into_iter()
+                .collect::<std::result::Result<Vec<_>, _>>()
+                .expect("every run")
+        };
+        let alone = ok(runs_side_by_side(2, &busy, 3, each));
         assert_eq!(alone.iter().map(|r| r.0).collect::<Vec<_>>(), [0, 10, 20]);
         assert_eq!(alone[0].1, here);
         assert!(alone[1..].iter().all(|r| r.1 != here));
         assert_ne!(alone[1].1, alone[2].1);
+        assert!(alone.iter().all(|r| r.2 == 1));
         assert_eq!(busy.load(Ordering::SeqCst), 0);
         busy.store(1, Ordering::SeqCst);
-        let beside = runs_side_by_side(2, &busy, 3, each);
+        let beside = ok(runs_side_by_side(2, &busy, 3, each));
         assert_eq!(beside.iter().map(|r| r.0).collect::<Vec<_>>(), [0, 10, 20]);
-        assert!(beside.iter().all(|r| r.1 == here));
+        assert!(beside.iter().all(|r| r.1 == here && r.2 == 2));
+        // One after the other, the runs stop at the first that fails.
+        let failing = |i: usize| if i == 1 { Err(i) } else { Ok(i) };
+        assert_eq!(runs_side_by_side(2, &busy, 3, failing), [Ok(0), Err(1)]);
         assert_eq!(busy.load(Ordering::SeqCst), 1);
         busy.store(0, Ordering::SeqCst);
+        // Side by side every run is simulated, the results in order.
+        assert_eq!(
+            runs_side_by_side(2, &busy, 3, failing),
+            [Ok(0), Err(1), Ok(2)]
+        );
         assert!(
-            runs_side_by_side(1, &busy, 3, each)
+            ok(runs_side_by_side(1, &busy, 3, each))
                 .iter()
                 .all(|r| r.1 == here)
         );
+        assert_eq!(busy.load(Ordering::SeqCst), 0);
     }
 
     /// A refit that leaves one tolerated value at the edge of its search range is refused
