@@ -67,13 +67,25 @@ fn run() -> Outcome {
             Outcome::Skipped(why)
         };
     }
-    // The command line the tests compare with is built by the tests (`cargo build`, a no-op
-    // when `cargo test` has just built it).
-    let out = Command::new(&python)
+    // The command line the tests compare with: the one `cargo test --workspace` has just
+    // built beside this test, when it is newer than every source it is built from; else
+    // the tests build it (`cargo build -p piano-action`, whose features differ from the
+    // workspace's: a second build of the dependencies, minutes on a clean clone).
+    let mut pytest = Command::new(&python);
+    pytest
         .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
         .arg(root.join("piano-py/tests"))
-        .current_dir(&root)
-        .output();
+        .current_dir(&root);
+    if std::env::var_os("PIANO_BIN").is_none() {
+        match built_piano(&root) {
+            Ok(bin) => {
+                println!("    piano: {} (built by this cargo test)", bin.display());
+                pytest.env("PIANO_BIN", bin);
+            }
+            Err(why) => println!("    piano: the tests build it ({why})"),
+        }
+    }
+    let out = pytest.output();
     match out {
         Err(e) => Outcome::Failed(format!("cannot run pytest: {e}")),
         Ok(out) => {
@@ -96,6 +108,56 @@ fn run() -> Outcome {
     }
 }
 
+/// The `piano` binary this test's build made (`target/debug/piano` beside
+/// `target/debug/deps/python-*`), if it is newer than every source of the crates it is
+/// built from; else why not.
+fn built_piano(root: &Path) -> Result<PathBuf, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("no path to this test: {e}"))?;
+    let bin = exe
+        .parent()
+        .and_then(Path::parent)
+        .map(|dir| dir.join(format!("piano{}", std::env::consts::EXE_SUFFIX)))
+        .ok_or_else(|| format!("no directory above {}", exe.display()))?;
+    let built_at = std::fs::metadata(&bin)
+        .and_then(|m| m.modified())
+        .map_err(|_| format!("no {}", bin.display()))?;
+    match newest_source(root, PIANO_SOURCES) {
+        Some((path, at)) if at > built_at => Err(format!(
+            "{} is older than {}",
+            bin.display(),
+            path.display()
+        )),
+        Some(_) => Ok(bin),
+        None => Err("no sources found".to_string()),
+    }
+}
+
+/// The sources of the `piano` command line.
+const PIANO_SOURCES: &[&str] = &[
+    "Cargo.toml",
+    "piano-action/Cargo.toml",
+    "piano-action/src",
+    "piano-action/validation",
+    "mbs-core/src",
+    "mbs-contact/src",
+    "mbs-integrators/src",
+    "mbs-identify/src",
+    "mbs-mechanism/src",
+];
+
+/// The sources of the Python package.
+const PACKAGE_SOURCES: &[&str] = &[
+    "piano-py/src",
+    "piano-py/Cargo.toml",
+    "piano-action/src",
+    "piano-action/validation",
+    "mbs-core/src",
+    "mbs-contact/src",
+    "mbs-integrators/src",
+    "mbs-identify/src",
+    "mbs-mechanism/src",
+];
+
 /// Why the installed package is older than the Rust code it is built from (None when it is
 /// not): its tests would test the old code.
 fn stale(python: &Path, root: &Path) -> Option<String> {
@@ -105,7 +167,7 @@ fn stale(python: &Path, root: &Path) -> Option<String> {
         .ok()?;
     let built = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
     let built_at = std::fs::metadata(&built).ok()?.modified().ok()?;
-    let newest = newest_source(root)?;
+    let newest = newest_source(root, PACKAGE_SOURCES)?;
     (newest.1 > built_at).then(|| {
         format!(
             "the installed piano_action ({}) is older than {}; install it again: \
@@ -117,23 +179,10 @@ fn stale(python: &Path, root: &Path) -> Option<String> {
     })
 }
 
-/// The most recently changed Rust source or manifest of the crates the package is built
-/// from.
-fn newest_source(root: &Path) -> Option<(PathBuf, std::time::SystemTime)> {
+/// The most recently changed Rust source, manifest or embedded table under `paths`.
+fn newest_source(root: &Path, paths: &[&str]) -> Option<(PathBuf, std::time::SystemTime)> {
     let mut newest: Option<(PathBuf, std::time::SystemTime)> = None;
-    let mut stack: Vec<PathBuf> = [
-        "piano-py/src",
-        "piano-py/Cargo.toml",
-        "piano-action/src",
-        "mbs-core/src",
-        "mbs-contact/src",
-        "mbs-integrators/src",
-        "mbs-identify/src",
-        "mbs-mechanism/src",
-    ]
-    .iter()
-    .map(|p| root.join(p))
-    .collect();
+    let mut stack: Vec<PathBuf> = paths.iter().map(|p| root.join(p)).collect();
     while let Some(path) = stack.pop() {
         let Ok(meta) = std::fs::metadata(&path) else {
             continue;
@@ -146,7 +195,7 @@ fn newest_source(root: &Path) -> Option<(PathBuf, std::time::SystemTime)> {
         }
         let source = path
             .extension()
-            .is_some_and(|e| e == "rs" || e == "toml" || e == "csv");
+            .is_some_and(|e| ["rs", "toml", "csv", "js", "css"].iter().any(|x| e == *x));
         if let (true, Ok(at)) = (source, meta.modified())
             && newest.as_ref().is_none_or(|(_, t)| at > *t)
         {
