@@ -562,12 +562,23 @@ impl NormalLaw for LankaraniNikravesh {
 /// McPhee & Birkett (J. Comput. Nonlinear Dyn. 1:47, 2006), with one exponent and a
 /// constant branch ratio `(1 − a)/(1 + a)`; the dissipation is rate independent for
 /// `|δ̇| ≫ v_ε`.
+///
+/// A felt whose loss also grows with the rate (a viscous share, as in Stulov's hereditary
+/// felt at slow loading, whose `F ≈ Q₀[xᵖ + α d(xᵖ)/dt]`) takes a Hunt–Crossley term
+/// ([`HystereticFelt::with_rate_damping`]):
+///
+/// `F = max(0, K δᵖ (1 + a tanh(δ̇ / v_ε) + (3/2) α δ̇))`,
+///
+/// which is [`HuntCrossley`] for `a = 0` and the rate-independent felt for `α = 0`; both
+/// terms only take energy, and the clip (at the end of a fast unloading) only keeps the
+/// felt from pulling.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HystereticFelt {
     stiffness: f64,
     exponent: f64,
     hysteresis: f64,
     v_eps: f64,
+    alpha: f64,
 }
 
 impl HystereticFelt {
@@ -581,7 +592,21 @@ impl HystereticFelt {
             exponent: check(LAW, "exponent", exponent, true)?,
             hysteresis: check_fraction(LAW, "hysteresis", hysteresis, false)?,
             v_eps: check(LAW, "v_eps", v_eps, true)?,
+            alpha: 0.0,
         })
+    }
+
+    /// The same felt with a Hunt–Crossley damping factor `α` (s/m, ≥ 0) on top of its
+    /// rate-independent hysteresis (see the type's documentation). Errors name
+    /// `hysteretic_felt.alpha`.
+    pub fn with_rate_damping(mut self, alpha: f64) -> Result<Self> {
+        self.alpha = check("hysteretic_felt", "alpha", alpha, false)?;
+        Ok(self)
+    }
+
+    /// The Hunt–Crossley damping factor `α` (s/m), 0 for a rate-independent felt.
+    pub fn rate_damping(&self) -> f64 {
+        self.alpha
     }
 
     /// The felt whose restitution is `e` (in `(0, 1]`) at every impact speed well above
@@ -621,34 +646,41 @@ impl HystereticFelt {
     }
 }
 
+impl HystereticFelt {
+    /// The factor on `K δᵖ`: `1 + a tanh(δ̇/v_ε) + (3/2) α δ̇` (may be negative; the force
+    /// clips it).
+    fn factor(&self, delta_dot: f64) -> f64 {
+        1.0 + self.hysteresis * (delta_dot / self.v_eps).tanh() + 1.5 * self.alpha * delta_dot
+    }
+}
+
 impl NormalLaw for HystereticFelt {
     fn force(&self, delta: f64, delta_dot: f64, _states: &[f64], _rates: &mut [f64]) -> f64 {
         if delta <= 0.0 {
             return 0.0;
         }
-        self.stiffness
-            * power(delta, self.exponent)
-            * (1.0 + self.hysteresis * (delta_dot / self.v_eps).tanh())
+        (self.stiffness * power(delta, self.exponent) * self.factor(delta_dot)).max(0.0)
     }
 
     fn tangent_stiffness(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
-        // ∂F/∂δ = p K δᵖ⁻¹ (1 + a tanh(δ̇/v_ε))
-        if delta <= 0.0 {
+        // ∂F/∂δ = p K δᵖ⁻¹ (1 + a tanh(δ̇/v_ε) + (3/2) α δ̇) where the force is positive.
+        let factor = self.factor(delta_dot);
+        if delta <= 0.0 || factor <= 0.0 {
             return Some(0.0);
         }
-        let switch = 1.0 + self.hysteresis * (delta_dot / self.v_eps).tanh();
-        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta * switch)
+        Some(self.exponent * self.stiffness * power(delta, self.exponent) / delta * factor)
     }
 
     fn rate_derivative(&self, delta: f64, delta_dot: f64, _states: &[f64]) -> Option<f64> {
-        // ∂F/∂δ̇ = K δᵖ a (1 − tanh²(δ̇/v_ε)) / v_ε
-        if delta <= 0.0 {
+        // ∂F/∂δ̇ = K δᵖ (a (1 − tanh²(δ̇/v_ε)) / v_ε + (3/2) α) where the force is positive.
+        if delta <= 0.0 || self.factor(delta_dot) <= 0.0 {
             return Some(0.0);
         }
         let th = (delta_dot / self.v_eps).tanh();
         Some(
-            self.stiffness * power(delta, self.exponent) * self.hysteresis * (1.0 - th * th)
-                / self.v_eps,
+            self.stiffness
+                * power(delta, self.exponent)
+                * (self.hysteresis * (1.0 - th * th) / self.v_eps + 1.5 * self.alpha),
         )
     }
 }

@@ -391,6 +391,15 @@ fn hysteretic_laws_dissipate_over_a_loading_unloading_cycle() {
             Box::new(KelvinVoigt::new(5e4, 20.0).unwrap()),
         ),
         (
+            "hysteretic felt a=0.1 with Hunt-Crossley alpha=1",
+            Box::new(
+                HystereticFelt::new(2.5e9, 2.5, 0.1, 1e-3)
+                    .unwrap()
+                    .with_rate_damping(1.0)
+                    .unwrap(),
+            ),
+        ),
+        (
             "Hunt-Crossley alpha=1",
             Box::new(HuntCrossley::new(2.5e9, 2.5, 1.0).unwrap()),
         ),
@@ -417,7 +426,7 @@ fn hysteretic_laws_dissipate_over_a_loading_unloading_cycle() {
             c.work
         );
         assert!(c.min_force >= 0.0, "{name} pulls: {}", c.min_force);
-        if name.starts_with("hysteretic") {
+        if *name == "hysteretic felt a=0.3" {
             // Rate-independent branches K(1 ± a)δᵖ: loses 2a/(1 + a) of the loading work
             // (less a little, from the tanh near the turning point).
             let expected = 2.0 * 0.3 / 1.3;
@@ -445,6 +454,61 @@ fn hysteretic_felt_branch_ratio() {
     assert_eq!(law.force(d, 0.0, &[], &mut []), elastic);
     assert_eq!(law.force(0.0, 1.0, &[], &mut []), 0.0);
     assert_eq!(law.force(-1e-3, 1.0, &[], &mut []), 0.0);
+}
+
+#[test]
+fn a_felt_with_rate_damping_is_hunt_crossley_without_its_hysteresis() {
+    // a = 0: the force of Hunt–Crossley's law at every compression and rate, the clip
+    // included; its impacts restitute as Hunt–Crossley's exact relation says (an
+    // analytic result, not this law's code).
+    let (k, p, alpha) = (1.3e7, 2.3, 1.5);
+    let felt = HystereticFelt::new(k, p, 0.0, 1e-3)
+        .unwrap()
+        .with_rate_damping(alpha)
+        .unwrap();
+    let hc = HuntCrossley::new(k, p, alpha).unwrap();
+    for d in [0.1e-3, 0.5e-3, 1.2e-3] {
+        for v in [-1.0, -0.3, -0.01, 0.0, 0.05, 0.8] {
+            let (a, b) = (felt.force(d, v, &[], &mut []), hc.force(d, v, &[], &mut []));
+            assert!(
+                (a - b).abs() <= 1e-12 * b.abs().max(1e-9),
+                "{d} {v}: {a} vs {b}"
+            );
+        }
+    }
+    for v0 in [0.05, 0.3, 1.0] {
+        let r = impact(&felt, 0.05, v0);
+        let exact = hc.restitution_at(v0);
+        assert!(
+            (r.restitution - exact).abs() < 2e-3,
+            "v0 = {v0}: {} vs {exact}",
+            r.restitution
+        );
+    }
+    // With its hysteresis too, a slow impact loses what the hysteresis loses and a fast
+    // one more: the restitution falls with the speed, below the rate-independent felt's.
+    let both = HystereticFelt::from_restitution(k, p, 0.8, 1e-3)
+        .unwrap()
+        .with_rate_damping(alpha)
+        .unwrap();
+    let slow = impact(&both, 0.05, 0.01).restitution;
+    let fast = impact(&both, 0.05, 0.5).restitution;
+    assert!((slow - 0.8).abs() < 0.03, "slow {slow}");
+    assert!(fast < slow - 0.1, "fast {fast} slow {slow}");
+    // Its analytic derivatives, against central differences (away from the clip).
+    for (d, v) in [(0.4e-3, 0.2), (0.9e-3, -0.2), (0.6e-3, 2e-4)] {
+        let f = |d: f64, v: f64| both.force(d, v, &[], &mut []);
+        let (hd, hv) = (1e-9, 1e-7);
+        let dd = (f(d + hd, v) - f(d - hd, v)) / (2.0 * hd);
+        let dv = (f(d, v + hv) - f(d, v - hv)) / (2.0 * hv);
+        let kd = both.tangent_stiffness(d, v, &[]).unwrap();
+        let kv = both.rate_derivative(d, v, &[]).unwrap();
+        assert!((kd - dd).abs() < 1e-5 * dd.abs(), "{d} {v}: {kd} vs {dd}");
+        assert!((kv - dv).abs() < 1e-5 * dv.abs(), "{d} {v}: {kv} vs {dv}");
+    }
+    assert_eq!(both.rate_damping(), alpha);
+    assert!(both.with_rate_damping(-1.0).is_err());
+    assert!(both.with_rate_damping(f64::NAN).is_err());
 }
 
 #[test]

@@ -310,11 +310,16 @@ pub fn normal_law(field: &str, l: &LawSpec) -> Result<MaterialLaw> {
     let err = contact_err(field);
     Ok(match l {
         LawSpec::Material(name) => material(&format!("{field}.material"), name)?.normal,
-        LawSpec::Felt { k, p, e, smoothing } => {
-            HystereticFelt::from_restitution(*k, *p, *e, *smoothing)
-                .map_err(err)?
-                .into()
-        }
+        LawSpec::Felt {
+            k,
+            p,
+            e,
+            smoothing,
+            alpha,
+        } => HystereticFelt::from_restitution(*k, *p, *e, *smoothing)
+            .and_then(|f| f.with_rate_damping(*alpha))
+            .map_err(err)?
+            .into(),
         LawSpec::Hertz { k, p } => Hertz::new(*k, *p).map_err(err)?.into(),
         LawSpec::KelvinVoigt { k, c } => KelvinVoigt::new(*k, *c).map_err(err)?.into(),
         LawSpec::HuntCrossley { k, p, alpha } => {

@@ -387,6 +387,8 @@ pub enum LawSpec {
     Material(String),
     /// Rate-independent hysteretic felt `F = k δᵖ (1 ± h)`, given by its restitution `e`;
     /// `smoothing` is the speed (m/s) over which the loading/unloading switch is smoothed.
+    /// A loss that also grows with the rate adds a Hunt–Crossley term, `alpha`:
+    /// `F = k δᵖ (1 ± h + (3/2) α δ̇)` (`mbs_contact::laws::HystereticFelt`).
     Felt {
         /// Stiffness (N/mᵖ).
         k: f64,
@@ -396,6 +398,10 @@ pub enum LawSpec {
         e: f64,
         /// Smoothing speed (m/s), > 0.
         smoothing: f64,
+        /// Hunt–Crossley damping factor (s/m), ≥ 0; 0 (the default, not written) for a
+        /// rate-independent felt.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        alpha: f64,
     },
     /// Elastic power law `F = k δᵖ`.
     Hertz {

@@ -231,7 +231,13 @@ pub(crate) fn law(field: &str, l: &LawSpec) -> Result<()> {
         LawSpec::Material(name) => {
             material(&format!("{field}.material"), name)?;
         }
-        LawSpec::Felt { k, p, e, smoothing } => {
+        LawSpec::Felt {
+            k,
+            p,
+            e,
+            smoothing,
+            alpha,
+        } => {
             positive(&format!("{field}.felt.k"), *k)?;
             positive(&format!("{field}.felt.p"), *p)?;
             let e = positive(&format!("{field}.felt.e"), *e)?;
@@ -242,6 +248,7 @@ pub(crate) fn law(field: &str, l: &LawSpec) -> Result<()> {
                 ));
             }
             positive(&format!("{field}.felt.smoothing"), *smoothing)?;
+            non_negative(&format!("{field}.felt.alpha"), *alpha)?;
         }
         LawSpec::Hertz { k, p } => {
             positive(&format!("{field}.hertz.k"), *k)?;

@@ -213,6 +213,26 @@ fn bad_descriptions_name_the_field_and_line() {
     assert!(e.message.contains("no material 'velvet'"), "{e}");
     assert!(e.message.contains("action_felt"), "lists the presets: {e}");
 
+    // A felt whose rate damping would give energy back; written without it, a felt
+    // reads as rate-independent and writes as it was read.
+    let text = edit(
+        "law = { material = \"action_felt\" }",
+        "law = { felt = { k = 1e7, p = 2.0, e = 0.4, smoothing = 1e-3, alpha = -0.5 } }",
+    );
+    let e = refused(&text, "toml");
+    assert_eq!(e.field, "contacts[0].law.felt.alpha");
+    assert_eq!(e.line, Some(line_of(&text, "alpha = -0.5")), "{e}");
+    let plain = Mechanism::from_toml_str(&edit(
+        "law = { material = \"action_felt\" }",
+        "law = { felt = { k = 1e7, p = 2.0, e = 0.4, smoothing = 1e-3 } }",
+    ))
+    .expect("a felt without alpha");
+    assert!(matches!(
+        plain.contacts[0].law,
+        mbs_mechanism::LawSpec::Felt { alpha, .. } if alpha == 0.0
+    ));
+    assert!(!plain.to_toml_string().unwrap().contains("alpha"));
+
     // A contact between a body and itself.
     let text = edit(
         "a = { body = \"ground\", shapes = [{ segment",

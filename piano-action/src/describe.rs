@@ -380,6 +380,7 @@ pub fn grand_mechanism(
                 p: law.p,
                 e: law.e,
                 smoothing: p.numerics.felt_smoothing_m_s,
+                alpha: 0.0,
             },
             friction: (law.mu > 0.0).then_some(ContactFrictionSpec::Coulomb {
                 mu: law.mu,

@@ -147,9 +147,12 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
             }
         }
         "knuckle_felt_hc" => {
+            // The library's felt with its whole loss by the rate is Hunt–Crossley's law:
+            // the exponent is the same quantity, and the share of the loss by the rate 1.
             if let Some(p) = get("p") {
                 out.push(("p", p));
             }
+            out.push(("rate_share", 1.0));
         }
         "knuckle_friction_visc" => {
             if let Some(d) = get("dmu") {

@@ -392,7 +392,14 @@ fn swapped_laws_change_the_run_and_the_same_law_changes_nothing() {
     // each as far as its own law says under the force on it, `δ = (F / k)^(1/p)` (still
     // creeping after 0.6 s at a few µm/s, well under the felt's 1 mm/s smoothing speed,
     // so within 2 % of it).
-    let LawSpec::Felt { k, p, e, smoothing } = m.contacts[0].law.clone() else {
+    let LawSpec::Felt {
+        k,
+        p,
+        e,
+        smoothing,
+        alpha,
+    } = m.contacts[0].law.clone()
+    else {
         panic!("the front rail is a felt")
     };
     assert_eq!(m.contacts[0].name, "front_rail");
@@ -401,6 +408,7 @@ fn swapped_laws_change_the_run_and_the_same_law_changes_nothing() {
         p,
         e,
         smoothing,
+        alpha,
     };
     let softer = m.swap_law("front_rail", soft).unwrap();
     let sunk = |m: &Mechanism, k: f64| {

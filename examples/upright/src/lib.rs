@@ -132,6 +132,7 @@ fn felt(k: f64, e: f64) -> LawSpec {
         p: 2.0,
         e,
         smoothing: 1e-3,
+        alpha: 0.0,
     }
 }
 

@@ -49,7 +49,8 @@ use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
 use super::action_effects::{
-    ACTION_EFFECTS, ActionEffect, HEAD_SHARE_START, action_effect_spec, file_values, marker_body_at,
+    ACTION_EFFECTS, ActionEffect, HEAD_SHARE_START, RATE_SHARE_START, action_effect_spec,
+    file_values, marker_body_at,
 };
 use super::data_check::{DataCheck, Run, dataset_error, noise_floor, observations, run_residuals};
 use super::diagnose::{
@@ -1509,7 +1510,7 @@ fn height_param(name: &str, start: f64, stated: f64) -> FreeParam {
     FreeParam::linear(name, start.clamp(lo, hi), lo, hi, 1e-4)
 }
 
-/// Bounds of a linear effect parameter whose search may not leave its range (none yet).
+/// Bounds of a linear effect parameter whose search may not leave its range.
 trait IdBounds {
     fn id_bounds(&self) -> Option<(f64, f64)>;
 }
@@ -1522,7 +1523,7 @@ impl IdBounds for mbs_identify::EffectParam {
             // A flexibility's location stays on its part.
             "cut_m" | "root_m" => Some((self.range[0], self.range[1])),
             // A share stays a share.
-            "head_share" => Some((0.0, 1.0)),
+            "head_share" | "rate_share" => Some((0.0, 1.0)),
             _ => None,
         }
     }
@@ -2063,13 +2064,23 @@ pub fn diagnose_key_drive(
             {
                 starts.push((c, start.clone()));
                 // A bent shank's refit also starts with half its compliance at the head's
-                // root (see `HEAD_SHARE_START`).
+                // root (see `HEAD_SHARE_START`), a felt's with its loss all by the rate
+                // (`RATE_SHARE_START`).
                 if let Some(e) = &start.effect
-                    && let Some(j) = e.spec.params.iter().position(|p| p.name == "head_share")
+                    && let Some((j, at)) =
+                        e.spec
+                            .params
+                            .iter()
+                            .enumerate()
+                            .find_map(|(j, p)| match p.name {
+                                "head_share" => Some((j, HEAD_SHARE_START)),
+                                "rate_share" => Some((j, RATE_SHARE_START)),
+                                _ => None,
+                            })
                 {
                     let mut two = start.clone();
                     if let Some(e) = two.effect.as_mut() {
-                        e.values[j] = HEAD_SHARE_START;
+                        e.values[j] = at;
                     }
                     starts.push((c, two));
                 }

@@ -938,7 +938,9 @@ fn felt_of(m: &Mechanism, name: &str) -> Result<(f64, f64, f64, f64), String> {
         .find(|c| c.name == name)
         .ok_or_else(|| format!("the description has no contact '{name}'"))?;
     match c.law {
-        LawSpec::Felt { k, p, e, smoothing } => Ok((k, p, e, smoothing)),
+        LawSpec::Felt {
+            k, p, e, smoothing, ..
+        } => Ok((k, p, e, smoothing)),
         ref other => Err(format!("contact '{name}' has law {other:?}, not a felt")),
     }
 }
@@ -1268,6 +1270,7 @@ impl Effect {
                     p,
                     e,
                     smoothing,
+                    alpha: 0.0,
                 };
                 log.push(format!(
                     "contact 'front_rail': Felt k = {k0:.4e}, p = {p0}, e = {e0} → Felt k = \
@@ -1333,6 +1336,7 @@ impl Effect {
                         p: p0,
                         e,
                         smoothing,
+                        alpha: 0.0,
                     };
                     log.push(format!(
                         "contact 'presser_key': Felt k = {k0:.4e}, p = {p0}, e = {e0} → Felt \
@@ -1549,6 +1553,7 @@ fn damper(
             p: 2.0,
             e: 0.3,
             smoothing,
+            alpha: 0.0,
         },
         friction: None,
     });
