@@ -495,6 +495,21 @@ fn a_felt_with_rate_damping_is_hunt_crossley_without_its_hysteresis() {
     let fast = impact(&both, 0.05, 0.5).restitution;
     assert!((slow - 0.8).abs() < 0.03, "slow {slow}");
     assert!(fast < slow - 0.1, "fast {fast} slow {slow}");
+    // A restitution split between the two as `e^(1 − s)` and `e^s` (each part's own
+    // restitution at the speed v0): an impact at v0 on the combined law restitutes close
+    // to `e`, the losses acting together.
+    for (e, share, v0) in [(0.7, 0.5, 0.1), (0.9, 0.96, 0.1), (0.5, 0.3, 0.1)] {
+        let by_rate = HuntCrossley::from_restitution_exact(k, p, f64::powf(e, share), v0)
+            .unwrap()
+            .alpha();
+        let split = HystereticFelt::from_restitution(k, p, f64::powf(e, 1.0 - share), 1e-3)
+            .unwrap()
+            .with_rate_damping(by_rate)
+            .unwrap();
+        let r = impact(&split, 0.05, v0).restitution;
+        eprintln!("e {e}, share {share}: an impact at {v0} m/s restitutes {r:.4}");
+        assert!((r / e - 1.0).abs() < 0.02, "e {e} share {share}: {r}");
+    }
     // Its analytic derivatives, against central differences (away from the clip).
     for (d, v) in [(0.4e-3, 0.2), (0.9e-3, -0.2), (0.6e-3, 2e-4)] {
         let f = |d: f64, v: f64| both.force(d, v, &[], &mut []);

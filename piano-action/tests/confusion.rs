@@ -147,12 +147,22 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
             }
         }
         "knuckle_felt_hc" => {
-            // The library's felt with its whole loss by the rate is Hunt–Crossley's law:
-            // the exponent is the same quantity, and the share of the loss by the rate 1.
+            // The exponent is the same quantity, and so is the restitution of an impact
+            // at the library's reference speed (`de` from the file's): Hunt–Crossley's
+            // exact relation, whatever the stiffness and mass. (Not the share: its truth,
+            // 1, lies on its bound, which any interval reaching it holds.)
             if let Some(p) = get("p") {
                 out.push(("p", p));
             }
-            out.push(("rate_share", 1.0));
+            if let Some(law) = get("alpha_s_per_m")
+                .and_then(|alpha| mbs_contact::laws::HuntCrossley::new(1.0, 2.0, alpha).ok())
+            {
+                let file = ActionParams::reference().contacts.jack_knuckle.e;
+                let e = law.restitution_at(
+                    piano_action::identify::action_effects::FELT_REFERENCE_SPEED_M_S,
+                );
+                out.push(("de", e - file));
+            }
         }
         "knuckle_friction_visc" => {
             if let Some(d) = get("dmu") {

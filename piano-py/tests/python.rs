@@ -132,16 +132,23 @@ fn built_piano(root: &Path) -> Result<PathBuf, String> {
     }
 }
 
-/// The sources of the `piano` command line.
+/// The sources of the `piano` command line, with the manifests and the lock file (a
+/// binary built before a dependency changed is as old as one built before a source did).
 const PIANO_SOURCES: &[&str] = &[
     "Cargo.toml",
+    "Cargo.lock",
     "piano-action/Cargo.toml",
     "piano-action/src",
     "piano-action/validation",
+    "mbs-core/Cargo.toml",
     "mbs-core/src",
+    "mbs-contact/Cargo.toml",
     "mbs-contact/src",
+    "mbs-integrators/Cargo.toml",
     "mbs-integrators/src",
+    "mbs-identify/Cargo.toml",
     "mbs-identify/src",
+    "mbs-mechanism/Cargo.toml",
     "mbs-mechanism/src",
 ];
 
@@ -193,9 +200,11 @@ fn newest_source(root: &Path, paths: &[&str]) -> Option<(PathBuf, std::time::Sys
             }
             continue;
         }
-        let source = path
-            .extension()
-            .is_some_and(|e| ["rs", "toml", "csv", "js", "css"].iter().any(|x| e == *x));
+        let source = path.extension().is_some_and(|e| {
+            ["rs", "toml", "lock", "csv", "js", "css"]
+                .iter()
+                .any(|x| e == *x)
+        });
         if let (true, Ok(at)) = (source, meta.modified())
             && newest.as_ref().is_none_or(|(_, t)| at > *t)
         {

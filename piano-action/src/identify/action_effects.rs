@@ -291,8 +291,10 @@ pub const RATE_SHARE_START: f64 = 1.0;
 
 /// The impact speed at which a felt's restitution is stated when part of its loss grows
 /// with the rate (m/s) [D]: the low end of the action's impact speeds, a knuckle pressed by
-/// the jack as the key goes down (`literature.md` §4.1's Hunt–Crossley `α = (1 − e)/v₀`
-/// then spans 0–10 s/m for the felts' 0.02–0.95 at 0.1 m/s).
+/// the jack as the key goes down. `literature.md` §4.1's Hunt–Crossley `α = (1 − e)/v₀`
+/// (first order) then spans 0.5–10 s/m for the felts' 0.95–0.02 at 0.1 m/s; the exact
+/// relation the law is built with gives more at a low restitution (14 s/m at 0.4, 330 at
+/// 0.02: a stiff term for a felt that loses nearly everything by its rate).
 pub const FELT_REFERENCE_SPEED_M_S: f64 = 0.1;
 
 /// A felt's force-law exponent [S] `identification.md` §2 (power laws F = Q₀ xᵖ with p ≈
@@ -605,12 +607,18 @@ pub fn file_values(spec: &EffectSpec, params: &ActionParams) -> Vec<Option<f64>>
         .collect()
 }
 
-/// Whether `values` are the effect's null (it changes nothing).
-pub fn is_null(spec: &EffectSpec, values: &[f64]) -> bool {
-    match (spec.params.first().and_then(|p| p.null), values.first()) {
-        (Some(null), Some(v)) => *v == null,
-        _ => false,
-    }
+/// Whether `values` are the effect's null (it changes nothing): every parameter with a
+/// file value ([`file_values`]) at it, the strength at its null. A felt at its null
+/// restitution shift with another exponent or share of its loss by the rate is not the
+/// file's felt.
+pub fn is_null(spec: &EffectSpec, values: &[f64], params: &ActionParams) -> bool {
+    let file = file_values(spec, params);
+    file.first().is_some_and(Option::is_some)
+        && values.len() == file.len()
+        && file
+            .iter()
+            .zip(values)
+            .all(|(f, v)| f.is_none_or(|f| f == *v))
 }
 
 /// The rod of shank from `from` to `to` along the hammer's axis (m from the flange pin),
@@ -690,7 +698,7 @@ pub fn apply(
     values: &[f64],
     params: &ActionParams,
 ) -> Result<Mechanism> {
-    if is_null(spec, values) {
+    if is_null(spec, values, params) {
         return Ok(mechanism.clone());
     }
     let body = |name: &str| {
@@ -949,10 +957,24 @@ mod tests {
             assert_ne!(t, m, "{} changed nothing", spec.id);
             t.build_with(&crate::describe::PianoExtensions)
                 .expect(spec.id);
-            // At its null it changes nothing.
-            let mut null = values.clone();
-            null[0] = spec.params[0].null.expect("strength has a null");
+            // At its null (a felt's law also at the file's) it changes nothing.
+            let null: Vec<f64> = file_values(spec, &params)
+                .iter()
+                .zip(&values)
+                .map(|(f, v)| f.unwrap_or(*v))
+                .collect();
+            assert_eq!(null[0], spec.params[0].null.expect("strength has a null"));
             assert_eq!(apply(&m, spec, &null, &params).expect(spec.id), m);
+        }
+        // The strength at its null with the felt's loss all by the rate, or another
+        // exponent, is not the file's felt.
+        let file = file_values(&FELT_HYSTERESIS, &params);
+        let (p0, s0) = (file[1].expect("exponent"), file[2].expect("share"));
+        for v in [[0.0, p0, 1.0], [0.0, p0 + 0.5, s0]] {
+            assert_ne!(
+                apply(&m, &FELT_HYSTERESIS, &v, &params).expect("applies"),
+                m
+            );
         }
     }
 
