@@ -168,6 +168,10 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
             if let Some(d) = get("dmu") {
                 out.push(("dmu", d));
             }
+            // The regularised law is the library's: its slip speed is the same quantity.
+            if let Some(v) = get("regularization_m_s") {
+                out.push(("slip_speed", v));
+            }
         }
         _ => {}
     }

@@ -10,7 +10,7 @@
 //! | `backcheck_compliance` | `mount_compliant` of the back-check's face on a wire rooted on the key: a body `backcheck` on a torsion spring | `compliance_rad_n_m` (0), `zeta` |
 //! | `keybed_felt` | `swap_law` of the front-rail punching: its stiffness scaled, its restitution set, its exponent | `k_scale` (1), `e`, `p` |
 //! | `felt_hysteresis` | `swap_law` of the knuckle's felt: its restitution (loading against unloading) shifted, its exponent, the share of its loss that grows with the rate (Hunt–Crossley) | `de` (0), `p`, `rate_share` |
-//! | `knuckle_friction` | `swap_friction` of the jack–knuckle contact: its friction coefficient raised | `dmu` (0) |
+//! | `knuckle_friction` | `swap_friction` of the jack–knuckle contact: its friction coefficient raised, the slip speed over which it builds up | `dmu` (0), `slip_speed` |
 //!
 //! A flex's damping is given by its ratio ζ: c = 2 ζ √(k I), I the moving part's inertia
 //! about its new joint; how far out the key's back arm carries its mass, its `reach`, is a
@@ -238,24 +238,54 @@ pub const FELT_HYSTERESIS: EffectSpec = EffectSpec {
         the knuckle's compression, friction with the jack's slide",
 };
 
-/// Extra friction at the jack–knuckle contact. Range [D]: dry buckskin or a worn knuckle
-/// up to μ ≈ 0.75 (the file's 0.15 plus 0.6).
+/// Extra friction at the jack–knuckle contact, and the slip speed over which it builds
+/// up. Range [D]: dry buckskin or a worn knuckle up to μ ≈ 0.75 (the file's 0.15 plus
+/// 0.6).
 pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
     id: "knuckle_friction",
     summary: "the jack slides on the knuckle with more friction than the file says",
-    params: &[EffectParam {
-        name: "dmu",
-        unit: "",
-        null: Some(0.0),
-        range: [0.0, 0.6],
-        typical: 0.15,
-        log_scale: false,
-        screen: &[],
-    }],
+    params: &[
+        EffectParam {
+            name: "dmu",
+            unit: "",
+            null: Some(0.0),
+            range: [0.0, 0.6],
+            typical: 0.15,
+            log_scale: false,
+            screen: &[],
+        },
+        KNUCKLE_SLIP_SPEED,
+    ],
     confusable_with: &["felt_hysteresis"],
     discriminating_experiment: "drop the mass from two heights: friction follows the jack's \
         slide under the knuckle, felt hysteresis its compression",
 };
+
+/// The slip speed (m/s) over which the knuckle's friction builds up to `μ N`, the
+/// regularised law's `v_ε` (`F = −μ N tanh(v / v_ε)`): the file's 1 mm/s is a numerical
+/// stand-in for dry Coulomb friction; a wider one is a friction that grows with the slip,
+/// viscous-like at the slow slide of a jack under a lubricated or worn knuckle. Range [M]
+/// (`literature.md` §4.3: "Coulomb (possibly + load-dependent + small viscous term),
+/// smoothed"; Armstrong-Hélouvry et al. 1994's survey puts the Stribeck velocities of
+/// lubricated contacts at 1e-4–1e-1 m/s): from the file's 1 mm/s to 0.1 m/s, about the
+/// jack's slide under the knuckle in a 1 kg drop, beyond which the friction is viscous
+/// over the whole slide. A shape, not screened; refitted from the file's speed and from
+/// [`SLIP_SPEED_START`]: at the file's 1 mm/s the friction of a slide at several cm/s is
+/// saturated and does not feel `v_ε` (a zero gradient).
+const KNUCKLE_SLIP_SPEED: EffectParam = EffectParam {
+    name: "slip_speed",
+    unit: "m/s",
+    null: None,
+    range: [1e-3, 0.1],
+    typical: 1e-3,
+    log_scale: true,
+    screen: &[],
+};
+
+/// The second start of a knuckle friction's refit (m/s) [D]: the geometric middle of the
+/// upper decade of [`KNUCKLE_SLIP_SPEED`]'s range, where the friction of a slide at a few
+/// cm/s depends on it.
+pub const SLIP_SPEED_START: f64 = 0.03;
 
 /// The share of a felt's loss that grows with the rate of compression, `s` in [0, 1]: of
 /// the restitution `e` an impact at [`FELT_REFERENCE_SPEED_M_S`] has, `e^(1 − s)` comes
@@ -602,6 +632,7 @@ pub fn file_values(spec: &EffectSpec, params: &ActionParams) -> Vec<Option<f64>>
             (_, "e", Some(f)) => Some(f.e),
             // The file's felts lose nothing by their rate.
             (_, "rate_share", Some(_)) => Some(0.0),
+            (_, "slip_speed", _) => Some(params.numerics.friction_regularization_m_s),
             _ => None,
         })
         .collect()
@@ -892,16 +923,21 @@ pub fn apply(
                 .find(|c| c.name == contact)
                 .ok_or_else(|| bad(spec.id, format!("the action has no contact '{contact}'")))?;
             let dmu = value(spec, values, "dmu")?;
+            let slip = value(spec, values, "slip_speed")?;
+            if !(slip.is_finite() && slip > 0.0) {
+                return Err(bad(
+                    spec.id,
+                    format!("slip_speed {slip} m/s must be positive"),
+                ));
+            }
             let friction = match pair.friction.clone() {
-                Some(ContactFrictionSpec::Coulomb { mu, regularization }) => {
-                    ContactFrictionSpec::Coulomb {
-                        mu: (mu + dmu).max(0.0),
-                        regularization,
-                    }
-                }
+                Some(ContactFrictionSpec::Coulomb { mu, .. }) => ContactFrictionSpec::Coulomb {
+                    mu: (mu + dmu).max(0.0),
+                    regularization: slip,
+                },
                 None => ContactFrictionSpec::Coulomb {
                     mu: dmu.max(0.0),
-                    regularization: 1e-3,
+                    regularization: slip,
                 },
                 Some(other) => {
                     return Err(bad(
@@ -1149,8 +1185,9 @@ mod tests {
         assert!(apply(&m, &SHANK_FLEX, &[c, 0.05, root, 1.5], &params).is_err());
     }
 
-    /// A felt's law is the file's at its file's restitution and exponent; a flex's place
-    /// and damping change nothing alone.
+    /// A felt's law is the file's at its file's restitution and exponent, a knuckle
+    /// friction's at the file's slip speed; a flex's place and damping change nothing
+    /// alone.
     #[test]
     fn an_effect_is_the_files_action_at_its_file_values() {
         let mut params = ActionParams::reference();
@@ -1168,7 +1205,11 @@ mod tests {
             file_values(&KEY_FLEX, &params),
             [Some(0.0), None, None, None]
         );
-        assert_eq!(file_values(&KNUCKLE_FRICTION, &params), [Some(0.0)]);
+        params.numerics.friction_regularization_m_s = 2e-3;
+        assert_eq!(
+            file_values(&KNUCKLE_FRICTION, &params),
+            [Some(0.0), Some(2e-3)]
+        );
         // At those values (the strength a hair off its null, where the effect is left
         // out) the felt's law is the file's: stiffness, exponent and restitution.
         let m = crate::describe::grand_mechanism(&params, ModelKind::Double, None).expect("grand");
@@ -1229,6 +1270,47 @@ mod tests {
         let t = apply(&m, &FELT_HYSTERESIS, &[0.3, 2.0, 1.0], &params).expect("applies");
         t.build_with(&crate::describe::PianoExtensions)
             .expect("builds");
+    }
+
+    /// A knuckle friction's slip speed is the regularised law's: the file's law at the
+    /// file's speed and no extra coefficient is the null, another speed is not; a bad
+    /// speed is refused by name.
+    #[test]
+    fn a_knuckle_frictions_slip_speed_is_its_laws() {
+        let (params, m) = grand();
+        let friction = |values: &[f64]| -> (f64, f64) {
+            let t = apply(&m, &KNUCKLE_FRICTION, values, &params).expect("applies");
+            match t
+                .contacts
+                .iter()
+                .find(|x| x.name == "jack_knuckle")
+                .and_then(|x| x.friction.clone())
+            {
+                Some(ContactFrictionSpec::Coulomb { mu, regularization }) => (mu, regularization),
+                other => panic!("{other:?}"),
+            }
+        };
+        let file = params.numerics.friction_regularization_m_s;
+        let mu0 = params.contacts.jack_knuckle.mu;
+        let (mu, v) = friction(&[0.2, 0.04]);
+        assert!((mu - (mu0 + 0.2)).abs() < 1e-12 && v == 0.04, "{mu} {v}");
+        assert_eq!(friction(&[0.0, file]), (mu0, file));
+        assert!(is_null(&KNUCKLE_FRICTION, &[0.0, file], &params));
+        assert!(!is_null(&KNUCKLE_FRICTION, &[0.0, 0.04], &params));
+        assert!(!is_null(&KNUCKLE_FRICTION, &[0.1, file], &params));
+        for bad in [0.0, -0.01] {
+            let err = apply(&m, &KNUCKLE_FRICTION, &[0.1, bad], &params)
+                .expect_err("refused")
+                .to_string();
+            assert!(
+                err.contains("knuckle_friction") && err.contains("slip_speed"),
+                "{err}"
+            );
+        }
+        // The file's speed is in the plausible range, the refit's second start too.
+        let range = KNUCKLE_FRICTION.params[1].range;
+        assert!((range[0]..=range[1]).contains(&file));
+        assert!((range[0]..=range[1]).contains(&SLIP_SPEED_START));
     }
 
     #[test]

@@ -49,8 +49,8 @@ use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
 
 use super::action_effects::{
-    ACTION_EFFECTS, ActionEffect, HEAD_SHARE_START, RATE_SHARE_START, action_effect_spec,
-    file_values, marker_body_at,
+    ACTION_EFFECTS, ActionEffect, HEAD_SHARE_START, RATE_SHARE_START, SLIP_SPEED_START,
+    action_effect_spec, file_values, marker_body_at,
 };
 use super::data_check::{DataCheck, Run, dataset_error, noise_floor, observations, run_residuals};
 use super::diagnose::{
@@ -2065,7 +2065,8 @@ pub fn diagnose_key_drive(
                 starts.push((c, start.clone()));
                 // A bent shank's refit also starts with half its compliance at the head's
                 // root (see `HEAD_SHARE_START`), a felt's with its loss all by the rate
-                // (`RATE_SHARE_START`).
+                // (`RATE_SHARE_START`), a knuckle friction's with a wide slip speed
+                // (`SLIP_SPEED_START`).
                 if let Some(e) = &start.effect
                     && let Some((j, at)) =
                         e.spec
@@ -2075,6 +2076,7 @@ pub fn diagnose_key_drive(
                             .find_map(|(j, p)| match p.name {
                                 "head_share" => Some((j, HEAD_SHARE_START)),
                                 "rate_share" => Some((j, RATE_SHARE_START)),
+                                "slip_speed" => Some((j, SLIP_SPEED_START)),
                                 _ => None,
                             })
                 {
