@@ -114,7 +114,7 @@ fn diagnose_case(
 /// Where a truth's effect has a value the library's parameter stands for (the same
 /// quantity of the same form): each such parameter and its true value. A flex at one
 /// place: its compliance (the truth's 1/k) and place; a felt's exponent; a friction's
-/// coefficient step; a shank bent at two places, its whole compliance and the share at
+/// coefficient step and slip speed; a shank bent at two places, its whole compliance and the share at
 /// the head's root. Forms the library has no parameter for (three hinges, a slide) have
 /// none.
 fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, f64)> {

@@ -243,7 +243,8 @@ pub const FELT_HYSTERESIS: EffectSpec = EffectSpec {
 /// 0.6).
 pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
     id: "knuckle_friction",
-    summary: "the jack slides on the knuckle with more friction than the file says",
+    summary: "the jack slides on the knuckle with another friction than the file says: more, \
+        or building up over a wider slip",
     params: &[
         EffectParam {
             name: "dmu",
@@ -263,15 +264,18 @@ pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
 
 /// The slip speed (m/s) over which the knuckle's friction builds up to `μ N`, the
 /// regularised law's `v_ε` (`F = −μ N tanh(v / v_ε)`): the file's 1 mm/s is a numerical
-/// stand-in for dry Coulomb friction; a wider one is a friction that grows with the slip,
-/// viscous-like at the slow slide of a jack under a lubricated or worn knuckle. Range [M]
-/// (`literature.md` §4.3: "Coulomb (possibly + load-dependent + small viscous term),
-/// smoothed"; Armstrong-Hélouvry et al. 1994's survey puts the Stribeck velocities of
-/// lubricated contacts at 1e-4–1e-1 m/s): from the file's 1 mm/s to 0.1 m/s, about the
-/// jack's slide under the knuckle in a 1 kg drop, beyond which the friction is viscous
-/// over the whole slide. A shape, not screened; refitted from the file's speed and from
-/// [`SLIP_SPEED_START`]: at the file's 1 mm/s the friction of a slide at several cm/s is
-/// saturated and does not feel `v_ε` (a zero gradient).
+/// stand-in for dry Coulomb friction (`literature.md` §4.3 smooths it "for ODE solvers");
+/// a wider one is a friction that grows with the slip, viscous-like at a slow slide (a
+/// lubricated or worn knuckle; the same section's "small viscous term"). Range [D]: from
+/// the file's 1 mm/s to 0.1 m/s, chosen so the law spans dry Coulomb friction to one
+/// viscous over most of a slow drop's slide; no measured slip speed of buckskin on a
+/// jack was found (Armstrong-Hélouvry et al. 1994 [M] survey the Stribeck velocity, over
+/// which a lubricated contact's friction *falls* from static to sliding, at 1e-5–1e-1
+/// m/s: another quantity, of the same order). A file value as a felt's exponent is: at
+/// it with no extra coefficient the effect is the file's friction. Not screened (held at
+/// the reference file's 1 mm/s there: a parameter file with another regularisation is
+/// screened at 1 mm/s); refitted from there and from [`SLIP_SPEED_START`]: at 1 mm/s the
+/// friction of a slide at several cm/s is saturated and hardly feels `v_ε`.
 const KNUCKLE_SLIP_SPEED: EffectParam = EffectParam {
     name: "slip_speed",
     unit: "m/s",
@@ -284,7 +288,9 @@ const KNUCKLE_SLIP_SPEED: EffectParam = EffectParam {
 
 /// The second start of a knuckle friction's refit (m/s) [D]: the geometric middle of the
 /// upper decade of [`KNUCKLE_SLIP_SPEED`]'s range, where the friction of a slide at a few
-/// cm/s depends on it.
+/// cm/s depends on it. Chosen after the independent truths were written, and inside their
+/// 0.02–0.05 m/s: a start, not a value the fit is held to (their seed 3 refitted to
+/// 0.063).
 pub const SLIP_SPEED_START: f64 = 0.03;
 
 /// The share of a felt's loss that grows with the rate of compression, `s` in [0, 1]: of

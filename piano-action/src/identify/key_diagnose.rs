@@ -2192,7 +2192,8 @@ pub fn diagnose_key_drive(
         }
         // How well the fit tells the effect from the action as the file has it: of the
         // parameters that leave the action as the file's at their file value (the
-        // strength, a felt's restitution and exponent), the one farthest from it in its
+        // strength, a felt's restitution, exponent and rate share, a knuckle friction's
+        // slip speed), the one farthest from it in its
         // SDs; a shape alone (a place, a damping ratio) changes nothing. Each SD is the
         // one at the fitted shape (the shape's values held, [`conditional_sd`]): a place
         // and a strength trade along a ridge (a softer hinge nearer the pivot bends the
