@@ -117,8 +117,20 @@ fn diagnose_case(
 /// coefficient step and slip speed; a shank bent at two places, its whole compliance and the share at
 /// the head's root. Forms the library has no parameter for (three hinges, a slide) have
 /// none.
-fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, f64)> {
+///
+/// A library parameter that is a change of a file value the truth's nuisance also
+/// changes (the punching's stiffness factor, the knuckle's friction step) is compared with
+/// the truth's whole change of that value, effect and nuisance together: a named effect's
+/// refit holds the nuisance's value at the file's, so what it fits is the whole (a
+/// punching drawn at 0.277 of the file's force with its stiffness's nuisance 0.90 is a
+/// punching at 0.249 of the file's).
+fn comparable(
+    case: &str,
+    effect: &BTreeMap<String, f64>,
+    nuisance: &BTreeMap<String, f64>,
+) -> Vec<(&'static str, f64)> {
     let get = |k: &str| effect.get(k).copied();
+    let factor = |k: &str| nuisance.get(k).copied().unwrap_or(1.0);
     let mut out = Vec::new();
     match case {
         "key_flex_far" | "shank_flex_mid" => {
@@ -143,7 +155,10 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
             {
                 out.push(("p", p));
                 out.push(("e", e));
-                out.push(("k_scale", ratio * 0.5f64.powf(p - 2.0)));
+                out.push((
+                    "k_scale",
+                    ratio * 0.5f64.powf(p - 2.0) * factor("contacts.front_rail.k"),
+                ));
             }
         }
         "knuckle_felt_hc" => {
@@ -166,7 +181,8 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
         }
         "knuckle_friction_visc" => {
             if let Some(d) = get("dmu") {
-                out.push(("dmu", d));
+                let file = ActionParams::reference().contacts.jack_knuckle.mu;
+                out.push(("dmu", d + file * (factor("contacts.jack_knuckle.mu") - 1.0)));
             }
             // The regularised law is the library's: its slip speed is the same quantity.
             if let Some(v) = get("regularization_m_s") {
@@ -178,13 +194,13 @@ fn comparable(case: &str, effect: &BTreeMap<String, f64>) -> Vec<(&'static str, 
     out
 }
 
-/// [`diagnose_case`], with the truth's effect values.
+/// [`diagnose_case`], with the truth's record (its effect's values and nuisance).
 fn diagnose_with_truth(
     case: &str,
     seed: u64,
     generate: &GenOptions,
     options: &KeyDiagnoseOptions,
-) -> (KeyDriveDiagnosis, BTreeMap<String, f64>) {
+) -> (KeyDriveDiagnosis, truths::TruthRecord) {
     let dir = scratch(&format!("{case}-{seed}"));
     let truth = dir.with_extension("truth.json");
     let record = truths::generate(case, seed, &dir, &truth, generate).expect("generates");
@@ -193,7 +209,7 @@ fn diagnose_with_truth(
         .expect("diagnoses");
     std::fs::remove_dir_all(&dir).ok();
     std::fs::remove_file(&truth).ok();
-    (d, record.effect)
+    (d, record)
 }
 
 fn short() -> GenOptions {
@@ -294,7 +310,7 @@ fn a_punching_of_another_exponent_is_named_with_its_exponent() {
     assert_eq!(d.decision, "named", "{}", d.summary);
     let named = d.effects.first().expect("a named effect");
     assert_eq!(named.id, "keybed_felt");
-    for (param, truth) in [("p", truth["p"]), ("e", truth["e"])] {
+    for (param, truth) in [("p", truth.effect["p"]), ("e", truth.effect["e"])] {
         let [lo, hi] = named.ci95[param];
         assert!(
             (lo..=hi).contains(&truth),
@@ -358,7 +374,7 @@ fn confusion_matrix_over_independent_truths() {
             // A named effect's comparable values: inside their 95 % interval?
             let mut inside = Vec::new();
             if let (Score::NamedRight, Some(e)) = (s, d.effects.first()) {
-                for (name, value) in comparable(case.id, &truth) {
+                for (name, value) in comparable(case.id, &truth.effect, &truth.nuisance) {
                     if let Some(&[lo, hi]) = e.ci95.get(name) {
                         let hit = (lo..=hi).contains(&value);
                         intervals += 1;
@@ -384,7 +400,7 @@ fn confusion_matrix_over_independent_truths() {
                     "best_params": d.best_candidate.as_ref().and_then(|b| d.candidates.iter().find(|c| &c.id == b)).map(|c| c.params.clone()),
                     "noise_check": d.noise_check.as_ref().map(|c| serde_json::json!({"explained": c.explained, "summary": c.summary()})),
                     "baseline_explained": d.baseline_noise_check.explained,
-                    "truth": truth, "intervals": inside,
+                    "truth": truth.effect, "nuisance": truth.nuisance, "intervals": inside,
                     "seconds": secs, "rev": rev,
                 })
             );
