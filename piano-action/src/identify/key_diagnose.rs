@@ -1677,6 +1677,34 @@ fn grid_of(spec: &EffectSpec) -> Vec<Vec<f64>> {
 /// the fit failed).
 type ScreenPoint = (Vec<f64>, Option<(f64, Setting)>);
 
+/// The shape parameters of `spec` (no null; not a share, whose bounds are its meaning) that
+/// `values` hold at an end of their plausible range, where their search stops: the data
+/// may ask for a value the family does not hold (a slip speed past 0.1 m/s, a flex's
+/// place at the end of its part). Said beside the candidate's outcome; no rule.
+fn shapes_at_range_end(spec: &EffectSpec, values: &[f64]) -> Vec<String> {
+    spec.params
+        .iter()
+        .zip(values)
+        .filter(|(p, v)| {
+            let at = |end: f64| (**v - end).abs() <= 1e-9 * end.abs().max(1e-300);
+            p.null.is_none() && !p.name.ends_with("_share") && (at(p.range[0]) || at(p.range[1]))
+        })
+        .map(|(p, v)| {
+            format!(
+                "{} = {v:.3e}{} at the end of its plausible [{:.1e}, {:.1e}]",
+                p.name,
+                if p.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", p.unit)
+                },
+                p.range[0],
+                p.range[1]
+            )
+        })
+        .collect()
+}
+
 /// Of the screened `points` of `spec` (grid values, fit), the index of the best fitted
 /// point for each value of its screened shape parameters (one index when none is
 /// screened); points whose fit failed are left out.
@@ -1954,6 +1982,8 @@ pub fn diagnose_key_drive(
         /// The rules it fails before the held-out run is judged.
         fails: Vec<String>,
         fall: f64,
+        /// Its shape values at an end of their range ([`shapes_at_range_end`]).
+        ends: Vec<String>,
         candidate: KeyCandidate,
     }
     let side_by_side = |tasks: usize| Problem {
@@ -2285,6 +2315,7 @@ pub fn diagnose_key_drive(
             joint: None,
             fails,
             fall,
+            ends: shapes_at_range_end(spec, &values),
             candidate,
         });
     }
@@ -2337,6 +2368,11 @@ pub fn diagnose_key_drive(
         } else {
             format!("dropped: {}", t.fails.join("; "))
         };
+    }
+    for t in tried.iter_mut().filter(|t| !t.ends.is_empty()) {
+        t.candidate
+            .why
+            .push_str(&format!(" ({})", t.ends.join("; ")));
     }
     clock.lap("candidates: held-out");
     progress("writing the diagnosis", 1.0);
@@ -2971,6 +3007,33 @@ mod tests {
         assert_eq!(shrink_text(2.0), "2.0×");
         assert_eq!(shrink_text(2.04), "2.0×");
         assert_eq!(shrink_text(49.0), "49.0×");
+    }
+
+    /// A shape held at an end of its range is said; a share on its bound, a strength, or a
+    /// shape inside its range is not.
+    #[test]
+    fn a_shape_at_the_end_of_its_range_is_said() {
+        let friction = action_effect_spec("knuckle_friction").expect("an effect");
+        let ends = shapes_at_range_end(friction, &[0.2, 0.1]);
+        assert_eq!(ends.len(), 1, "{ends:?}");
+        assert!(
+            ends[0].starts_with("slip_speed = 1.000e-1 m/s at the end"),
+            "{ends:?}"
+        );
+        assert!(shapes_at_range_end(friction, &[0.2, 0.03]).is_empty());
+        assert!(shapes_at_range_end(friction, &[0.6, 0.03]).is_empty());
+        let felt = action_effect_spec("felt_hysteresis").expect("an effect");
+        assert!(shapes_at_range_end(felt, &[0.1, 2.0, 1.0]).is_empty());
+        let key = action_effect_spec("key_flex").expect("an effect");
+        let mut v: Vec<f64> = key.params.iter().map(|p| p.typical).collect();
+        let cut = key
+            .params
+            .iter()
+            .position(|p| p.name == "cut_m")
+            .expect("cut_m");
+        v[cut] = key.params[cut].range[1];
+        let ends = shapes_at_range_end(key, &v);
+        assert!(ends.len() == 1 && ends[0].starts_with("cut_m"), "{ends:?}");
     }
 
     #[test]
