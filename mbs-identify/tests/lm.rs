@@ -661,3 +661,115 @@ fn secant_updates_still_converge_in_a_valley() {
         assert!((fit.values[0] - 1.0).abs() < 1e-6 && (fit.values[1] - 1.0).abs() < 1e-6);
     }
 }
+
+/// The score's inflation reads independent errors as themselves (about 1) and an AR(1)
+/// error as the variance factor of its batches' sums: for ρ 0.95 over batches of 100,
+/// `(L(1 + ρ)/(1 − ρ) − 2ρ(1 − ρᴸ)/(1 − ρ)²)/L` = 31.4, times 19/20 for the fitted
+/// offset's share of each batch (Box, Jenkins & Reinsel's sum of an AR(1) process).
+#[test]
+fn the_score_inflation_is_one_for_noise_and_the_correlations_factor_otherwise() {
+    let options = LmOptions {
+        score_batches: 20,
+        ..LmOptions::default()
+    };
+    let seeds = 40;
+    let independent: f64 = (0..seeds)
+        .map(|seed| {
+            let fit = fit_decay(&decay_data(seed), &options);
+            fit.score_inflation.expect("an inflation")
+        })
+        .sum::<f64>()
+        / seeds as f64;
+    assert!(
+        (0.8..=1.15).contains(&independent),
+        "independent errors: {independent:.3}"
+    );
+    let (rho, n) = (0.95, 2000);
+    let correlated: f64 = (0..seeds)
+        .map(|seed| {
+            let mut noise = Noise::new(5000 + seed);
+            let mut e = noise.gaussian();
+            let data: Vec<(f64, f64)> = (0..n)
+                .map(|j| {
+                    let t = j as f64 / n as f64;
+                    e = rho * e + (1.0 - rho * rho).sqrt() * noise.gaussian();
+                    (t, 1.0 + 2.0 * t + e)
+                })
+                .collect();
+            let params = vec![
+                FreeParam::linear("a", 0.0, -10.0, 10.0, 1.0),
+                FreeParam::linear("b", 0.0, -10.0, 10.0, 1.0),
+            ];
+            let fit = levenberg_marquardt(
+                &params,
+                |x: &[f64]| Ok(data.iter().map(|&(t, y)| x[0] + x[1] * t - y).collect()),
+                &options,
+            )
+            .expect("a line fits");
+            fit.score_inflation.expect("an inflation")
+        })
+        .sum::<f64>()
+        / seeds as f64;
+    assert!(
+        (22.0..=40.0).contains(&correlated),
+        "AR(1) errors: {correlated:.1}"
+    );
+    eprintln!("score inflation: independent {independent:.3}, AR(1) {correlated:.1}");
+    let plain = fit_decay(&decay_data(1), &LmOptions::default());
+    assert_eq!(plain.score_inflation, None, "no batches, no inflation");
+}
+
+/// A prior's terms after the data (`score_rows`) stay out of the score's inflation: where
+/// a prior holds a fit off the data's optimum, a fit with the prior's row reads the same
+/// inflation as the data alone at that point; counted, the prior's row, whose score there
+/// is the data's whole score turned round, changes it.
+#[test]
+fn a_priors_rows_stay_out_of_the_score_inflation() {
+    let data = decay_data(3);
+    let n = data.len();
+    let fit = |prior: bool, rows: usize, params: &[FreeParam], iterations: usize| {
+        let model = |x: &[f64]| {
+            let mut r: Vec<f64> = data
+                .iter()
+                .map(|&(t, y)| (x[0] * (-x[1] * t).exp() - y) / SIGMA)
+                .collect();
+            if prior {
+                r.push((x[0] - 0.9 * A_TRUE) / (0.02 * A_TRUE));
+            }
+            Ok(r)
+        };
+        let options = LmOptions {
+            score_batches: 20,
+            score_rows: rows,
+            max_iterations: iterations,
+            ..LmOptions::default()
+        };
+        levenberg_marquardt(params, model, &options).expect("a fit")
+    };
+    let held = fit(true, n, &decay_params(), 40);
+    // Stopped before a first step from the held optimum: the Jacobian there.
+    let mut at = decay_params();
+    for (p, v) in at.iter_mut().zip(&held.values) {
+        p.start = *v;
+    }
+    let inflation = |prior: bool, rows: usize| {
+        fit(prior, rows, &at, 0)
+            .score_inflation
+            .expect("an inflation")
+    };
+    let data_alone = inflation(false, 0);
+    let rows_left_out = inflation(true, n);
+    let rows_counted = inflation(true, 0);
+    eprintln!(
+        "inflation: data {data_alone:.2}, prior left out {rows_left_out:.2}, counted \
+         {rows_counted:.2}"
+    );
+    assert!(
+        (rows_left_out - data_alone).abs() <= 0.02 * data_alone,
+        "{rows_left_out} for {data_alone}"
+    );
+    assert!(
+        (rows_counted - data_alone).abs() > 0.15 * data_alone,
+        "{rows_counted} for {data_alone}"
+    );
+}

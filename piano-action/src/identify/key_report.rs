@@ -145,6 +145,16 @@ fn tolerated_text(d: &KeyDriveDiagnosis, html: bool) -> String {
         },
         super::key_diagnose::MOVED_P_MIN
     );
+    let text = match d.tolerated_tempered {
+        Some(c) => format!(
+            "{text} The first such refit asked for more than the makers hold, with a score \
+             that varied {c:.1} times what the noise says (the model's own error, which the \
+             noise model reads as evidence): these values are those of the refit with the \
+             runs' evidence weighted 1/{c:.1} (Holmes & Walker 2017, a likelihood's power \
+             for a model that does not hold exactly)."
+        ),
+        None => text,
+    };
     if html {
         format!("<p>{}</p>\n", escape(&text))
     } else {
