@@ -145,8 +145,8 @@ pub struct LmOptions {
     pub score_batches: usize,
     /// How many of the residuals, from the first, are data the batches cover (default 0:
     /// all). The rows after them (a prior's terms, which are not drawn from the noise) are
-    /// left out of the sandwich's meat and of [`LmFit::score_inflation`]; the bread
-    /// `JᵀJ` keeps them.
+    /// left out of the sandwich's meat, whose bread `JᵀJ` keeps them, and out of
+    /// [`LmFit::score_inflation`] altogether.
     #[serde(default)]
     pub score_rows: usize,
     /// Broyden's rank-one update of the Jacobian after an accepted step instead of new
@@ -244,14 +244,19 @@ pub struct LmFit {
     /// Why it stopped.
     pub stop: Stop,
     /// How many times more the score varies than the residuals' own units say: with
-    /// [`LmOptions::score_batches`] `b ≥ 2`, `tr M / tr JᵀJ` in the parameters'
-    /// unit-normalised coordinates, `M` the batch-means meat (as the sandwich's), the
-    /// residuals read as standard deviations of their noise (1 when they are its
-    /// independent draws, `(1 + ρ)/(1 − ρ)` for an AR(1) error of correlation `ρ` over
-    /// batches long against it). Its inverse is the diagonal reading of Holmes & Walker's
-    /// (2017, *Biometrika* 104(2):497–503) power of a likelihood the model does not hold
-    /// exactly, `tr(I J⁻¹ Iᵀ)/tr I`, exact for one parameter. `None` without batches,
-    /// without a Jacobian at the optimum or where the sandwich has none.
+    /// [`LmOptions::score_batches`] `b ≥ 2`, the batch-means meat's trace (as the
+    /// sandwich's, in the parameters' unit-normalised coordinates, over the data's rows,
+    /// [`LmOptions::score_rows`]) over its expectation for independent errors of unit
+    /// variance at the same Jacobian, the residuals first projected off the data's columns
+    /// (so that a prior's or a bound's pull, which leaves them a systematic score, is not
+    /// read as their variance). 1 when the residuals are their noise's independent draws;
+    /// about `(1 + ρ)/(1 − ρ)` for an AR(1) error of correlation `ρ` over batches long
+    /// against it. For one parameter its inverse is Holmes & Walker's (2017, *Biometrika*
+    /// 104(2):497–503) power of a likelihood the model does not hold exactly (the Hessian's
+    /// information over the score's variance); for several it is the ratio of their traces,
+    /// which the most inflated directions dominate. `None` without batches or without a
+    /// Jacobian at the stop (a fit with [`LmOptions::covariance`] off may stop without one),
+    /// or when no column moves a residual.
     pub score_inflation: Option<f64>,
 }
 
@@ -1154,14 +1159,18 @@ fn covariance_batch_means(jac: &[Vec<f64>], r: &[f64], batches: usize) -> Option
 
 /// The batch-means meat's trace in unit-normalised coordinates over its expectation for
 /// independent errors of unit variance at this Jacobian (see [`LmFit::score_inflation`]);
-/// `None` with fewer residuals than batches or no column that moves a residual (columns
-/// of zeros, a parameter nothing depends on here, are left out). The expectation is not
-/// the columns' count: the fitted residuals are orthogonal to each column, which takes
-/// from every batch its share of the column's fit, `E sᵢ_b² = ‖uᵢ_b‖² − gᵢ_bᵀ G⁺ gᵢ_b` with
-/// `uᵢ_b` the unit column's part in batch `b`, `gᵢ_b = U_bᵀ uᵢ_b` and `G = UᵀU` (19/20 of
-/// it for an offset over 20 equal batches, about 0.6 for an exponential decay whose column
-/// lies in its first batches): the leverage correction of a cluster-robust meat (Bell &
-/// McCaffrey 2002).
+/// `None` with fewer residuals than batches, no column that moves a residual (columns of
+/// zeros, a parameter nothing depends on here, and non-finite ones are left out) or an
+/// expectation lost to round-off. The residuals are first projected off the columns,
+/// `r − U G⁺ Uᵀ r` (`U` the unit columns, `G = UᵀU`): at an unconstrained optimum that
+/// changes nothing; where a prior or a bound holds a parameter off the data's optimum it
+/// takes out the systematic score that pull leaves. The expectation is not the columns'
+/// count: projected residuals are `(I − H) e`, which takes from every batch its share of
+/// each column, `E sᵢ_b² = ‖uᵢ_b‖² − gᵢ_bᵀ G⁺ gᵢ_b` with `uᵢ_b` the unit column's part in
+/// batch `b` and `gᵢ_b = U_bᵀ uᵢ_b` (19/20 of it for an offset over 20 equal batches,
+/// about 0.6 for an exponential decay whose column lies in its first batches): a
+/// leverage correction in the spirit of Bell & McCaffrey's (2002) for cluster-robust
+/// variances, as one ratio of expectations.
 fn score_inflation(jac: &[Vec<f64>], r: &[f64], batches: usize) -> Option<f64> {
     let n = r.len();
     let unit: Vec<Vec<f64>> = jac
@@ -1177,20 +1186,30 @@ fn score_inflation(jac: &[Vec<f64>], r: &[f64], batches: usize) -> Option<f64> {
     }
     let gram = DMatrix::from_fn(k, k, |i, j| dot(&unit[i], &unit[j]));
     let inverse = gram.pseudo_inverse(SINGULAR_RCOND).ok()?;
+    let ur = DVector::from_iterator(k, unit.iter().map(|u| dot(u, r)));
+    let coef = &inverse * ur;
+    let projected: Vec<f64> = (0..n)
+        .map(|t| r[t] - (0..k).map(|i| unit[i][t] * coef[i]).sum::<f64>())
+        .collect();
     let (mut meat, mut expected) = (0.0, 0.0);
     for b in 0..batches {
         let (from, to) = (b * n / batches, (b + 1) * n / batches);
         let part = |i: usize| &unit[i][from..to];
         let block = DMatrix::from_fn(k, k, |i, j| dot(part(i), part(j)));
         for i in 0..k {
-            let score = dot(part(i), &r[from..to]);
+            let score = dot(part(i), &projected[from..to]);
             meat += score * score;
             let g = block.column(i);
             expected += block[(i, i)] - (g.transpose() * &inverse * g)[(0, 0)];
         }
     }
+    // Each unit column's batches hold 1 in all; below a millionth of that the ratio is
+    // round-off's.
+    if expected.is_nan() || expected <= 1e-6 * k as f64 {
+        return None;
+    }
     let inflation = meat / expected;
-    (expected > 0.0 && inflation.is_finite()).then_some(inflation)
+    inflation.is_finite().then_some(inflation)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
