@@ -274,7 +274,8 @@ pub const KNUCKLE_FRICTION: EffectSpec = EffectSpec {
 /// m/s: another quantity, of the same order). A file value as a felt's exponent is: at
 /// it with no extra coefficient the effect is the file's friction. Not screened (held at
 /// the reference file's 1 mm/s there: a parameter file with another regularisation is
-/// screened at 1 mm/s); refitted from there and from [`SLIP_SPEED_START`]: at 1 mm/s the
+/// screened at 1 mm/s); held at 1 mm/s and at [`SLIP_SPEED_START`] by the fitted drop's two
+/// fits, freed by the refit on every run: at 1 mm/s the
 /// friction of a slide at several cm/s is saturated and hardly feels `v_ε`.
 const KNUCKLE_SLIP_SPEED: EffectParam = EffectParam {
     name: "slip_speed",
@@ -289,8 +290,9 @@ const KNUCKLE_SLIP_SPEED: EffectParam = EffectParam {
 /// The second start of a knuckle friction's refit (m/s) [D]: the geometric middle of the
 /// upper decade of [`KNUCKLE_SLIP_SPEED`]'s range, where the friction of a slide at a few
 /// cm/s depends on it. Chosen after the independent truths were written, and inside their
-/// 0.02–0.05 m/s: a start, not a value the fit is held to (their seed 3 refitted to
-/// 0.063).
+/// 0.02–0.05 m/s: the fitted drop's fits hold it there (or at the file's 1 mm/s), the
+/// refit on every run frees it (their seed 3 refitted to 0.063 when it was free from the
+/// start). A truth far from both holds is a test of that refit, not of this start.
 pub const SLIP_SPEED_START: f64 = 0.03;
 
 /// The share of a felt's loss that grows with the rate of compression, `s` in [0, 1]: of
