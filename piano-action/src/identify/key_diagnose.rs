@@ -1538,7 +1538,8 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
                  {c:.1}× what the noise says)"
             )
         });
-    if let Some(m) = moved.filter(|m| m.too_far()) {
+    let too_far = moved.filter(|m| m.too_far());
+    if let Some(m) = too_far {
         check.fail_also(format!(
             "every run explained only with values held at the file's moved beyond their \
              tolerance ({}; p {:.1e} < {MOVED_P_MIN}){tempered}",
@@ -1546,8 +1547,10 @@ fn noise_check_of(problem: &Problem<'_>, eval: &[(Vec<f64>, Simulated)]) -> Nois
             m.p()
         ));
     }
-    // Or one that wants a value beyond the edge of its search range?
+    // Or one that wants a value beyond the edge of its search range? (The weighting said
+    // once.)
     if let Some(edge) = moved.and_then(Moved::at_edge) {
+        let tempered = if too_far.is_some() { "" } else { &tempered };
         check.fail_also(format!(
             "every run explained only with {edge} at the edge of the search (a held \
              value's edge is twice its makers' tolerance){tempered}: the runs ask for more"
