@@ -1285,6 +1285,8 @@ impl<'a> Problem<'a> {
                 if let Some(f) = t.iter_mut().find(|f| f.name == name) {
                     f.start = alt.clamp(f.lower, f.upper);
                     tries.push(t);
+                    // (a fit of its own in the diagnosis's count)
+                    self.work.add_fit();
                 }
             }
         }
