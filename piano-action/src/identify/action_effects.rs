@@ -68,16 +68,18 @@ pub const KEY_FLEX: EffectSpec = EffectSpec {
 /// The hammer shank bends: the head on a torsion spring `root_m` along the shank (at the
 /// head's root, 110 mm, typically; anywhere from 30 mm, beyond the knuckle, to 115 mm
 /// [D]: the one hinge stands for the shank's first mode, wherever it bends most; screened
-/// at 40, 75 and 110 mm, each refitted). Range [D]: a hornbeam shank (d ≈ 8 mm, EI ≈ 2 N·m²) is some 40 N·m/rad at the head's root; the
-/// range allows 10 times stiffer and 80 times softer. The typical (visible) value, 0.15
+/// at 40, 75 and 110 mm, each refitted). Range [D]: a hornbeam shank (d ≈ 8 mm, EI ≈ 2
+/// N·m²) is some 40 N·m/rad at the head's root; the range allows 10 times stiffer and 80
+/// times softer. The typical (visible) value, 0.15
 /// rad/(N·m) (a thin shank, 6 times softer than that estimate), is where the gap after
 /// the check's catch holds several noise floors under nuisance: at 0.05 the calibrated
 /// baseline misses it there by 1.4 floors only (measured, seed 1, with the head lumped
 /// before it was made the whole hammer less the shank). The head is what the file's whole
 /// hammer leaves after the shank up to the hinge ([`SHANK_KG_M`]) and the knuckle under it
-/// at the flange ([`KNUCKLE_KG`]): the measured whole is the surest thing known of it. A `head_share` of the compliance goes on a second hinge
-/// at the head's root ([`HEAD_ROOT_M`]): one hinge turns the shank's middle and the head
-/// by one angle, two bend them apart.
+/// at the flange ([`KNUCKLE_KG`]): the measured whole is the surest thing known of it. A
+/// `head_share` of the compliance goes on a second hinge at the head's root
+/// ([`HEAD_ROOT_M`]): one hinge turns the shank's middle and the head by one angle, two
+/// bend them apart.
 pub const SHANK_FLEX: EffectSpec = EffectSpec {
     id: "shank_flex",
     summary: "the hammer shank bends: the head turns on a torsion spring along the shank \
@@ -710,8 +712,8 @@ fn inertia_about(part: &MassProps, at: [f64; 2]) -> f64 {
 /// The grand `mechanism` with its shank bent at two places, `[compliance, zeta, root,
 /// share]`: `share` of the compliance at the head's root ([`head_hinge_m`]), the rest at
 /// `root` (none when the share is 1). The head is what the whole hammer leaves after the
-/// shank up to the head's root and the knuckle ([`hammer_kept`]); the shank between the hinges, a rod, is a body of its
-/// own; the one-hinge model's head is the two together.
+/// shank up to the head's root and the knuckle ([`hammer_kept`]); the shank between the
+/// hinges, a rod, is a body of its own; the one-hinge model's head is the two together.
 fn bend_shank_at_two(
     mechanism: &Mechanism,
     params: &ActionParams,
