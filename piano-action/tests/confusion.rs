@@ -537,3 +537,49 @@ fn a_partial_explanation_reports_the_values_it_had_to_move() {
         );
     }
 }
+
+/// A shank bent at two places (seed 1: 12.5 and 10.1 N·m/rad at 50 and 110 mm), two
+/// drops: the library's bending key fits the fitted drop better than its bent shank, but
+/// its refit on every run leaves residuals that are not white; the bent shank, judged
+/// next, explains every run. The fitted drop favours one, the noise check the other, and
+/// neither says more: the outcome is an ambiguity that holds the truth, the key's failure
+/// said, never the key's name (before, the key alone was judged: `partly_explained`).
+#[test]
+fn the_next_candidate_is_judged_when_the_fitted_drops_best_leaves_the_noise() {
+    let d = diagnose_case(
+        "shank_flex_two",
+        1,
+        &GenOptions::default(),
+        &library(&["key_flex", "shank_flex"]),
+    );
+    assert_eq!(d.decision, "ambiguous", "{}", d.summary);
+    assert_eq!(
+        score(&Expected::Family("shank_flex"), &d),
+        Score::AmbiguousRight
+    );
+    let key = d
+        .candidates
+        .iter()
+        .find(|c| c.id == "key_flex")
+        .expect("the key judged");
+    let shank = d
+        .candidates
+        .iter()
+        .find(|c| c.id == "shank_flex")
+        .expect("the shank judged");
+    assert!(
+        key.delta_bic < shank.delta_bic,
+        "the key fits the fitted drop better"
+    );
+    assert!(key.heldout_rms_m.is_some() && shank.heldout_rms_m.is_some());
+    assert_eq!(d.best_candidate.as_deref(), Some("shank_flex"));
+    assert!(d.noise_check.as_ref().is_some_and(|c| c.explained));
+    assert!(
+        d.summary.contains(
+            "key_flex fitted the fitted runs better, but its refit on every run does not \
+             explain the data: residuals not white"
+        ),
+        "{}",
+        d.summary
+    );
+}
