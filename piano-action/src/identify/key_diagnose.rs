@@ -243,8 +243,9 @@ pub fn tolerance_sd(tol: f64) -> f64 {
 /// whose held-out run fails does not count): the best alone left a shank bent at two
 /// places (the independent truths' `shank_flex_two`, seeds 1, 4, 5) `partly_explained` by
 /// a bending key whose refit on every run left the held-out head's residuals not white,
-/// the bent shank never judged (seed 1 is named with the second judged); each judgment
-/// costs a refit on every run (35–90 s on 2 cores), so one more than the best.
+/// the bent shank never judged (seed 1 comes out ambiguous between the two, the truth
+/// among them); each judgment costs a refit on every run (35–90 s on 2 cores), so one
+/// more than the best.
 pub const JUDGED_MAX: usize = 2;
 
 /// The least factor by which a named effect must shrink the flagged phase's gap [S]
@@ -268,8 +269,12 @@ pub fn shrink_text(x: f64) -> String {
 
 /// How far (noise SDs, whitened) an effect may move any of the rise's residuals from the
 /// calibrated baseline's for a screening point to keep the rise's calibration as it is
-/// [D]: a hundredth of the noise moves a calibrated value by about a hundredth of its
-/// SD, nothing a recalibration would find.
+/// [D]: a hundredth of the noise, scattered, moves a calibrated value by about a
+/// hundredth of its SD. A move that bound allows on every residual at once could shift a
+/// value by up to 0.01·√N of its SD over N residuals; the effects that skip here (a
+/// punching the key meets after the rise) leave the rise unchanged to the last digit, but
+/// a bound on the whole vector's norm, which holds every value within 0.01 SD, is the
+/// sounder test (an independent review's finding, not yet changed).
 pub const RISE_UNMOVED: f64 = 0.01;
 
 /// The most accepted steps of a screening point's refit of what the rise cannot see
@@ -363,7 +368,8 @@ pub struct KeyCandidate {
     /// Their 95 % intervals.
     pub ci95: BTreeMap<String, [f64; 2]>,
     /// Whether it passed every rule (the held-out run is judged in BIC order until one
-    /// does: the ones ranked below are not kept, and say so).
+    /// that does explains the data, or [`JUDGED_MAX`] that do have not: the ones ranked
+    /// below are not kept, and say so).
     pub kept: bool,
     /// Whether it passed the BIC and effect-size rules (a rival an unseparated
     /// confusable effect must be told apart from).
@@ -2505,10 +2511,12 @@ pub fn diagnose_key_drive(
     // The held-out run (a refit of its release and clock per run) is judged in BIC
     // order, until an effect passes every rule and its refit on every run explains the
     // data, or [`JUDGED_MAX`] effects have passed every rule without: the ones ranked
-    // below are left unjudged. The fitted drop's ranking is not the data's last word: a shank bent at two
-    // places (the independent truths' `shank_flex_two`, seeds 1, 4, 5) was fitted better
-    // on the fitted drop by a bending key, whose refit on every run left the held-out
-    // head's residuals not white, and the bent shank behind it was never judged.
+    // below are left unjudged. The fitted drop's ranking is not the data's last word: a
+    // shank bent at two places (the independent truths' `shank_flex_two`, seeds 1, 4, 5)
+    // was fitted better on the fitted drop by a bending key, whose refit on every run
+    // left the held-out head's residuals not white, and the bent shank behind it was
+    // never judged.
+    //
     // The shrink over the flagged phase and what follows it within 10 ms when it lasts
     // less (a 1-frame free flight is no measure; the noise check's shortest cell). Not
     // the whole of the phases after it: a let-off of 2 ms merged with the 250 ms after
@@ -2605,8 +2613,10 @@ pub fn diagnose_key_drive(
     clock.lap("candidates: held-out");
     progress("writing the diagnosis", 1.0);
 
-    // E. The decision: the lowest BIC of the kept; rivals within the BIC margin, or
-    // confusable with it and not separated by the markers, make it ambiguous.
+    // E. The decision: the first kept (in BIC order) that explains the data, else the
+    // first kept; rivals within the BIC margin (a better-ranked one that does not explain
+    // the data among them), or confusable with it and not separated by the markers, make
+    // it ambiguous.
     let heights: Vec<f64> = problem.runs.iter().map(|r| r.release).collect();
     let mut kept: Vec<usize> = (0..tried.len())
         .filter(|&i| tried[i].candidate.kept)
@@ -2647,7 +2657,8 @@ pub fn diagnose_key_drive(
             // `key_flex_beam` seed 2, fitted 904 whitened BIC better with the library's
             // bending key than with its bent shank, held out 84 % closer against 77 %,
             // and failed only by asking the lever knuckle's friction ×0.71 on every run;
-            // the bent shank explained every run, and was named.)
+            // the bent shank explained every run and, taken alone, was named: a wrong
+            // name.)
             if i == b || !t.candidate.rival {
                 continue;
             }
