@@ -576,7 +576,7 @@ fn the_next_candidate_is_judged_when_the_fitted_drops_best_leaves_the_noise() {
     assert!(d.noise_check.as_ref().is_some_and(|c| c.explained));
     assert!(
         d.summary.contains(
-            "key_flex fitted the fitted runs better, but its refit on every run does not \
+            "key_flex fits the fitted drop better, but its refit on every run does not \
              explain the data: residuals not white"
         ),
         "{}",

@@ -267,14 +267,13 @@ pub fn shrink_text(x: f64) -> String {
     }
 }
 
-/// How far (noise SDs, whitened) an effect may move any of the rise's residuals from the
-/// calibrated baseline's for a screening point to keep the rise's calibration as it is
-/// [D]: a hundredth of the noise, scattered, moves a calibrated value by about a
-/// hundredth of its SD. A move that bound allows on every residual at once could shift a
-/// value by up to 0.01·√N of its SD over N residuals; the effects that skip here (a
-/// punching the key meets after the rise) leave the rise unchanged to the last digit, but
-/// a bound on the whole vector's norm, which holds every value within 0.01 SD, is the
-/// sounder test (an independent review's finding, not yet changed).
+/// How far (noise SDs, whitened; the norm of the whole vector) an effect may move the
+/// rise's residuals from the calibrated baseline's for a screening point to keep the
+/// rise's calibration as it is [D]: a move of the whitened residuals of norm ε moves a
+/// calibrated value by at most ε of its SD (the Gauss–Newton step is a projection), so a
+/// hundredth of the noise leaves every value within a hundredth of its SD. The effects
+/// that skip here (a punching the key meets after the rise) leave the rise unchanged to
+/// the last digit.
 pub const RISE_UNMOVED: f64 = 0.01;
 
 /// The most accepted steps of a screening point's refit of what the rise cannot see
@@ -2186,7 +2185,9 @@ pub fn diagnose_key_drive(
                 r.len() == rise.fit.residuals.len()
                     && r.iter()
                         .zip(&rise.fit.residuals)
-                        .all(|(a, b)| (a - b).abs() <= RISE_UNMOVED)
+                        .map(|(a, b)| (a - b).powi(2))
+                        .sum::<f64>()
+                        <= RISE_UNMOVED.powi(2)
             });
             let mut s = if unmoved {
                 start
@@ -2536,6 +2537,10 @@ pub fn diagnose_key_drive(
             window_rms(r0, &t.fit_res[0], flag_window.0, flag_window.1, None),
         )
     };
+    // A baseline that explains the data needs nothing: past the first, no other is judged
+    // (a second that explains the data too would turn its `none` into a name).
+    let base_check = noise_check_of(&problem, base_joint.as_deref().unwrap_or(&base_eval));
+    let judged_max = if base_check.explained { 1 } else { JUDGED_MAX };
     let mut order: Vec<usize> = (0..tried.len()).collect();
     order.sort_by(|&a, &b| tried[a].fitted.bic.total_cmp(&tried[b].fitted.bic));
     let (mut judged, mut explained_yet) = (0usize, false);
@@ -2545,13 +2550,16 @@ pub fn diagnose_key_drive(
             t.candidate.why = format!("dropped: {}", t.fails.join("; "));
             continue;
         }
-        if explained_yet || judged >= JUDGED_MAX {
+        if explained_yet || judged >= judged_max {
             t.candidate.why = if explained_yet {
                 "passes the rules judged; its held-out run was not judged (a better-ranked \
                  effect explains the data)"
+            } else if base_check.explained {
+                "passes the rules judged; its held-out run was not judged (the baseline \
+                 explains the data already)"
             } else {
-                "passes the rules judged; its held-out run was not judged (the effects ranked \
-                 above it were judged, none explains the data)"
+                "passes the rules judged; its held-out run was not judged (two better-ranked \
+                 effects were judged, neither explains the data)"
             }
             .to_string();
             continue;
@@ -2595,7 +2603,8 @@ pub fn diagnose_key_drive(
                         c.summary()
                     ),
                     Some((_, false)) => format!(
-                        "; it shrinks the flagged gap only {} (needs {SHRINK_MIN}×)",
+                        "; its fit of the fitted drop shrinks the flagged gap only {} (needs \
+                         {SHRINK_MIN}×)",
                         shrink_text(shrink_of(t))
                     ),
                     _ => String::new(),
@@ -2638,13 +2647,7 @@ pub fn diagnose_key_drive(
     // ambiguity's summary.
     let outranked: Vec<usize> = best
         .filter(|&b| explaining(b))
-        .map(|b| {
-            kept.iter()
-                .copied()
-                .take_while(|&i| i != b)
-                .filter(|&i| tried[i].check.is_some())
-                .collect()
-        })
+        .map(|b| kept.iter().copied().take_while(|&i| i != b).collect())
         .unwrap_or_default();
     let mut ambiguous_with = Vec::new();
     // (rival, whitened BIC of the separating markers in the best's favour)
@@ -2710,7 +2713,6 @@ pub fn diagnose_key_drive(
     // floors, white residuals) and shrink the flagged phase's gap twice or more; short
     // of that the outcome is `partly_explained`, with what the best takes and what it
     // leaves (issue 33).
-    let base_check = noise_check_of(&problem, base_joint.as_deref().unwrap_or(&base_eval));
     let best_check = best.and_then(|b| tried[b].check.as_ref().map(|c| c.0.clone()));
     let shrink = best.map(|b| shrink_of(&tried[b]));
     let explains = best.is_some_and(explaining);
@@ -2772,7 +2774,7 @@ pub fn diagnose_key_drive(
                 outranked
                     .iter()
                     .map(|&i| format!(
-                        " ({} fitted the fitted runs better, but its refit on every run does \
+                        " ({} fits the fitted drop better, but its refit on every run does \
                          not explain the data: {})",
                         tried[i].spec.id,
                         tried[i]
@@ -2780,7 +2782,7 @@ pub fn diagnose_key_drive(
                             .as_ref()
                             .map_or_else(String::new, |c| if c.0.explained {
                                 format!(
-                                    "it shrinks the flagged gap only {}",
+                                    "its fit of the fitted drop shrinks the flagged gap only {}",
                                     shrink_text(shrink_of(&tried[i]))
                                 )
                             } else {
