@@ -398,6 +398,7 @@ fn confusion_matrix_over_independent_truths() {
                     "summary": d.summary, "best": d.best_candidate, "shrink": d.flagged_shrink,
                     "effects": d.effects.iter().map(|e| serde_json::json!({"id": e.id, "params": e.params, "ci95": e.ci95})).collect::<Vec<_>>(),
                     "best_params": d.best_candidate.as_ref().and_then(|b| d.candidates.iter().find(|c| &c.id == b)).map(|c| c.params.clone()),
+                    "best_ci95_fitted": d.best_candidate.as_ref().and_then(|b| d.candidates.iter().find(|c| &c.id == b)).map(|c| c.ci95.clone()),
                     "noise_check": d.noise_check.as_ref().map(|c| serde_json::json!({"explained": c.explained, "summary": c.summary()})),
                     "baseline_explained": d.baseline_noise_check.explained,
                     "truth": truth.effect, "nuisance": truth.nuisance, "intervals": inside,

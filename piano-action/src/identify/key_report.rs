@@ -180,6 +180,20 @@ fn tolerance_note(path: &str, factor: f64) -> String {
     }
 }
 
+/// Where a named effect's values and intervals come from: the refit on every run (with a
+/// held-out run), else the fit on the fitted runs.
+fn interval_source(d: &KeyDriveDiagnosis) -> String {
+    if d.tolerated.is_empty() {
+        "(values and 95 % intervals of the fit on the fitted runs)".to_string()
+    } else {
+        "(values of the refit on every run, the values the makers tolerate free within \
+         their tolerance; each 95 % interval the hull of that refit's and the fit on the \
+         fitted runs', which holds those values at the file's: neither alone admits the \
+         model's error)"
+            .to_string()
+    }
+}
+
 /// The readable report.
 pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
     let mut s = String::new();
@@ -193,6 +207,7 @@ pub fn markdown(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             let ci = super::report::interval_text(e.ci95.get(name).copied());
             let _ = write!(s, " `{name}` = {v:.3e} ({ci});");
         }
+        let _ = write!(s, " {}", interval_source(d));
         s.push_str("\n\n");
     }
     if let Some(x) = &d.separating_experiment {
@@ -396,6 +411,7 @@ pub fn html(d: &KeyDriveDiagnosis, dataset: &Path) -> String {
             let ci = super::report::interval_text(e.ci95.get(name).copied());
             let _ = write!(s, "<code>{}</code> = {v:.3e} ({ci}) ", escape(name));
         }
+        let _ = write!(s, "<i>{}</i>", escape(&interval_source(d)));
         s.push_str("</p>\n");
     }
     if let Some(x) = &d.separating_experiment {
