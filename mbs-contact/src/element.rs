@@ -2,6 +2,7 @@
 //! of an `mbs_core::System`.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use mbs_core::{
     BodyId, Crossing, ForceContext, ForceElement, LoadJacobian, Loads, Model, central_difference,
@@ -81,12 +82,26 @@ pub struct ContactOutput {
 /// forces act at the midpoint of the two nearest surface points, equal and opposite on the
 /// two bodies. Its switching function is the gap, so an integrator can locate onset and
 /// release.
-#[derive(Clone)]
 pub struct Contact {
     name: String,
     sides: [ResolvedSide; 2],
     normal: Arc<dyn NormalLaw>,
     friction: Option<Arc<dyn TangentialLaw>>,
+    /// The earliest time its laws acted ([`Contact::acted_from`]), as `f64` bits
+    /// (infinity: never).
+    acted: AtomicU64,
+}
+
+impl Clone for Contact {
+    fn clone(&self) -> Self {
+        Self {
+            name: self.name.clone(),
+            sides: self.sides.clone(),
+            normal: self.normal.clone(),
+            friction: self.friction.clone(),
+            acted: AtomicU64::new(self.acted.load(Ordering::Relaxed)),
+        }
+    }
 }
 
 impl std::fmt::Debug for Contact {
@@ -130,7 +145,43 @@ impl Contact {
             sides,
             normal: Arc::new(normal),
             friction: None,
+            acted: AtomicU64::new(f64::INFINITY.to_bits()),
         })
+    }
+
+    /// The earliest time (s) at which its laws acted since it was built (or cloned from one
+    /// that had), `None` if they never did: an evaluation of its loads or their derivatives
+    /// where the shapes overlapped, or any where its normal law keeps states (whose rates
+    /// it gives apart as well). Until then every evaluation went as if its laws were any
+    /// others: a solve that agrees with another everywhere else gives the same result, to
+    /// the last bit, as long as it is evaluated only before that time (see
+    /// `mbs_integrators::Checkpoint`).
+    pub fn acted_from(&self) -> Option<f64> {
+        let t = f64::from_bits(self.acted.load(Ordering::Relaxed));
+        (t != f64::INFINITY).then_some(t)
+    }
+
+    /// Whether its laws have acted since it was built ([`Contact::acted_from`]).
+    pub fn touched(&self) -> bool {
+        self.acted_from().is_some()
+    }
+
+    /// Notes that its laws acted at time `t` (a time that is not a number counts as the
+    /// earliest).
+    fn touch(&self, t: f64) {
+        let t = if t.is_nan() { f64::NEG_INFINITY } else { t };
+        let mut seen = self.acted.load(Ordering::Relaxed);
+        while t < f64::from_bits(seen) {
+            match self.acted.compare_exchange_weak(
+                seen,
+                t.to_bits(),
+                Ordering::Relaxed,
+                Ordering::Relaxed,
+            ) {
+                Ok(_) => break,
+                Err(now) => seen = now,
+            }
+        }
     }
 
     /// The same contact with friction.
@@ -345,6 +396,7 @@ impl ForceElement for Contact {
         if p.gap >= 0.0 && self.normal.state_count() == 0 {
             return;
         }
+        self.touch(ctx.t);
         let out = self.compute_at(p, ctx, rates);
         if !out.active {
             return;
@@ -374,6 +426,7 @@ impl ForceElement for Contact {
         if p.gap.is_nan() || p.gap >= 0.0 {
             return;
         }
+        self.touch(ctx.t);
         let out = self.compute_at(p, ctx, &mut []);
         if !out.active {
             return;

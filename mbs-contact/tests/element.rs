@@ -288,3 +288,47 @@ fn the_integrator_locates_contact_onset_and_release() {
         "{duration} vs {half_period}"
     );
 }
+
+/// A contact whose shapes stay apart has not acted, and a solve's result does not depend
+/// on its laws; once the shapes overlap at an evaluation, it has; a clone keeps the mark.
+#[test]
+fn a_contact_knows_whether_its_laws_have_acted() {
+    let model = two_bodies();
+    let disc = Shape::circle([0.0, 0.0], 0.05).unwrap();
+    let face = Shape::segment([0.4, 0.0], [0.0, 0.0]).unwrap();
+    let build = |k: f64| {
+        Contact::new(
+            &model,
+            "disc-arm",
+            ContactSide::on("slider", vec![disc]),
+            ContactSide::on("arm", vec![face]),
+            Linear(k),
+        )
+        .unwrap()
+    };
+    let (soft, stiff) = (build(1e3), build(1e6));
+    let loads_of = |contact: &Contact, x: &[f64]| {
+        let mut system = System::new(model.clone());
+        let e = system.add_element(contact.clone()).unwrap();
+        let mut ws = system.workspace();
+        let ctx = system.element_context(&mut ws, 0.0, x, e).unwrap();
+        let mut tau = vec![0.0; 2];
+        let mut forces = vec![Force::ZERO; model.nbodies()];
+        contact.apply(&ctx, &mut Loads::new(&mut tau, &mut forces), &mut []);
+        (
+            tau,
+            forces.iter().map(|f| [f.fx, f.fy, f.n]).collect::<Vec<_>>(),
+        )
+    };
+    // The slider far from the arm: no load, whatever the stiffness, and nothing acted.
+    let apart = [2.0, 0.0, 0.0, 0.0];
+    assert_eq!(loads_of(&soft, &apart), loads_of(&stiff, &apart));
+    assert!(!soft.touched() && !stiff.touched());
+    // Pressed into the arm: loads that differ with the law, and both marked.
+    let pressed = [0.45, -0.1, 0.2, -0.3];
+    assert_ne!(loads_of(&soft, &pressed), loads_of(&stiff, &pressed));
+    assert!(soft.touched() && stiff.touched());
+    assert_eq!(soft.acted_from(), Some(0.0));
+    assert!(soft.clone().touched());
+    assert!(!build(1e3).clone().touched());
+}

@@ -69,6 +69,250 @@ pub fn solve_observed(
     handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Solution> {
+    let (stepper, mut run) = begin(sys, method, t0, y0, t_end, opts)?;
+    go_on(stepper, &mut run, t_end, opts, handler, progress, None)
+}
+
+/// A solve's whole state after an accepted step ([`solve_checkpointed`]), from which
+/// [`resume`] goes on: the method's state (step size, Jacobian, factorisation), the output
+/// and events so far (as counts into the solution it came from), the work counts.
+pub struct Checkpoint {
+    stepper: Box<dyn Stepper + Send + Sync>,
+    method: Method,
+    opts: Options,
+    t0: f64,
+    /// The time reached (s).
+    pub t: f64,
+    /// The latest time at which the system had been evaluated when it was taken (s): a
+    /// step tried and rejected may have looked beyond [`Checkpoint::t`]. A system that
+    /// agrees with the one solved wherever it was evaluated before that time goes on from
+    /// here exactly as its own solve would, to the last bit.
+    pub evaluated_until: f64,
+    outputs: usize,
+    next_grid: usize,
+    events: usize,
+    stats: Stats,
+    g_prev: Vec<f64>,
+}
+
+impl std::fmt::Debug for Checkpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Checkpoint")
+            .field("t", &self.t)
+            .field("evaluated_until", &self.evaluated_until)
+            .field("outputs", &self.outputs)
+            .field("events", &self.events)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Integrates like [`solve_observed`] and keeps a [`Checkpoint`] after the first accepted
+/// step past every multiple of `every` (s) from `t0`, in time order. Only the TR-BDF2
+/// method offers them: another gives none. The solution is the same as
+/// [`solve_observed`]'s, to the last bit.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_checkpointed(
+    sys: &mut dyn OdeSystem,
+    method: Method,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    opts: &Options,
+    handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
+    progress: &mut dyn FnMut(f64),
+    every: f64,
+) -> Result<(Solution, Vec<Checkpoint>)> {
+    if !(every.is_finite() && every > 0.0) {
+        return Err(IntegratorError::InvalidOption {
+            option: "every",
+            message: format!("checkpoints every {every} s: need a positive time"),
+        });
+    }
+    let until = std::cell::Cell::new(f64::NEG_INFINITY);
+    let mut watched = Watched { sys, until: &until };
+    let (stepper, mut run) = begin(&mut watched, method, t0, y0, t_end, opts)?;
+    let mut kept = Vec::new();
+    let mut keep = Keep {
+        every,
+        next: t0 + every,
+        method,
+        opts,
+        until: &until,
+        kept: &mut kept,
+    };
+    let sol = go_on(
+        stepper,
+        &mut run,
+        t_end,
+        opts,
+        handler,
+        progress,
+        Some(&mut keep),
+    )?;
+    Ok((sol, kept))
+}
+
+/// Goes on from `checkpoint`, taken in the solve that gave `base` ([`solve_checkpointed`]),
+/// with the system `sys` up to `t_end`: `base`'s output and events up to the checkpoint,
+/// then `sys`'s. When `sys` agrees with the system `base` was solved with wherever that one
+/// was evaluated before [`Checkpoint::evaluated_until`], the result is `sys`'s own solve
+/// from `base`'s start, to the last bit (its work counts included). Fails when `opts` or
+/// `method` differ from the checkpoint's, or when `base` is shorter than it.
+#[allow(clippy::too_many_arguments)]
+pub fn resume(
+    sys: &mut dyn OdeSystem,
+    method: Method,
+    base: &Solution,
+    checkpoint: &Checkpoint,
+    t_end: f64,
+    opts: &Options,
+    handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Solution> {
+    if method != checkpoint.method || *opts != checkpoint.opts {
+        return Err(IntegratorError::InvalidOption {
+            option: "method",
+            message: "a solve resumes with the method and options of its checkpoint".into(),
+        });
+    }
+    let n = sys.len();
+    if base.n != n
+        || base.t.len() < checkpoint.outputs
+        || base.y.len() < checkpoint.outputs * n
+        || base.events.len() < checkpoint.events
+        || sys.event_count() != checkpoint.g_prev.len()
+    {
+        return Err(IntegratorError::InvalidInitialCondition(
+            "the checkpoint does not belong to this solution and system".into(),
+        ));
+    }
+    if !(t_end.is_finite() && t_end >= checkpoint.t) {
+        return Err(IntegratorError::InvalidInitialCondition(format!(
+            "need a finite t_end >= the checkpoint's {}, got {t_end}",
+            checkpoint.t
+        )));
+    }
+    let stepper =
+        checkpoint
+            .stepper
+            .boxed_clone()
+            .ok_or_else(|| IntegratorError::InvalidOption {
+                option: "method",
+                message: "the checkpoint's method cannot be copied".into(),
+            })?;
+    let mut run = Run::new(sys, opts, n, checkpoint.t0);
+    run.t.extend_from_slice(&base.t[..checkpoint.outputs]);
+    run.y.extend_from_slice(&base.y[..checkpoint.outputs * n]);
+    run.events
+        .extend_from_slice(&base.events[..checkpoint.events]);
+    run.next_grid = checkpoint.next_grid;
+    run.stats = checkpoint.stats;
+    run.g_prev.copy_from_slice(&checkpoint.g_prev);
+    go_on(stepper, &mut run, t_end, opts, handler, progress, None)
+}
+
+/// Where a checkpointed solve keeps its checkpoints.
+struct Keep<'k> {
+    every: f64,
+    next: f64,
+    method: Method,
+    opts: &'k Options,
+    /// The latest time the system was evaluated at ([`Watched`]).
+    until: &'k std::cell::Cell<f64>,
+    kept: &'k mut Vec<Checkpoint>,
+}
+
+/// A system that notes the latest time it is evaluated at (for [`Checkpoint`]); it
+/// forwards every call.
+struct Watched<'a> {
+    sys: &'a mut dyn OdeSystem,
+    until: &'a std::cell::Cell<f64>,
+}
+
+impl Watched<'_> {
+    fn saw(&mut self, t: f64) {
+        if t > self.until.get() {
+            self.until.set(t);
+        }
+    }
+}
+
+impl OdeSystem for Watched<'_> {
+    fn len(&self) -> usize {
+        self.sys.len()
+    }
+    fn is_empty(&self) -> bool {
+        self.sys.is_empty()
+    }
+    fn derivative(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        dy: &mut [f64],
+    ) -> std::result::Result<(), crate::SystemError> {
+        self.saw(t);
+        self.sys.derivative(t, y, dy)
+    }
+    fn has_jacobian(&self) -> bool {
+        self.sys.has_jacobian()
+    }
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        jac: &mut nalgebra::DMatrix<f64>,
+    ) -> std::result::Result<(), crate::SystemError> {
+        self.saw(t);
+        self.sys.jacobian(t, y, jac)
+    }
+    fn jacobian_given_rate(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        f: &[f64],
+        jac: &mut nalgebra::DMatrix<f64>,
+    ) -> std::result::Result<(), crate::SystemError> {
+        self.saw(t);
+        self.sys.jacobian_given_rate(t, y, f, jac)
+    }
+    fn states_outside_jacobian(&self) -> Vec<std::ops::Range<usize>> {
+        self.sys.states_outside_jacobian()
+    }
+    fn second_order_split(&self) -> Option<usize> {
+        self.sys.second_order_split()
+    }
+    fn event_count(&self) -> usize {
+        self.sys.event_count()
+    }
+    fn events(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        out: &mut [f64],
+    ) -> std::result::Result<(), crate::SystemError> {
+        self.saw(t);
+        self.sys.events(t, y, out)
+    }
+    fn event_direction(&self, k: usize) -> Crossing {
+        self.sys.event_direction(k)
+    }
+    fn event_source(&self, k: usize) -> Option<crate::EventSource> {
+        self.sys.event_source(k)
+    }
+    fn event_name(&self, k: usize) -> String {
+        self.sys.event_name(k)
+    }
+}
+
+/// Checks the start and builds the method and the bookkeeping, at `(t0, y0)`.
+fn begin<'s>(
+    sys: &'s mut dyn OdeSystem,
+    method: Method,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    opts: &Options,
+) -> Result<(Box<dyn Stepper + 's>, Run<'s>)> {
     opts.validate(method)?;
     let n = sys.len();
     if y0.len() != n {
@@ -104,6 +348,19 @@ pub fn solve_observed(
     stepper.start(run.sys, t0, y0, &mut run.stats)?;
     run.output_point(t0, y0);
     run.init_events(t0, y0)?;
+    Ok((stepper, run))
+}
+
+/// Steps `stepper` on to `t_end`, keeping checkpoints in `keep` if given.
+fn go_on(
+    mut stepper: Box<dyn Stepper + '_>,
+    run: &mut Run<'_>,
+    t_end: f64,
+    opts: &Options,
+    handler: &mut dyn FnMut(&Event, &mut [f64]) -> EventAction,
+    progress: &mut dyn FnMut(f64),
+    mut keep: Option<&mut Keep<'_>>,
+) -> Result<Solution> {
     let mut termination = Termination::Finished;
     let mut since_check = 0;
     while stepper.t() < t_end {
@@ -140,6 +397,29 @@ pub fn solve_observed(
                 run.init_events(t_event, &y_event)?;
             }
         }
+        if let Some(k) = keep.as_deref_mut()
+            && stepper.t() >= k.next
+            && stepper.t() < t_end
+        {
+            while k.next <= stepper.t() {
+                k.next += k.every;
+            }
+            if let Some(copy) = stepper.boxed_clone() {
+                k.kept.push(Checkpoint {
+                    stepper: copy,
+                    method: k.method,
+                    opts: k.opts.clone(),
+                    t0: run.t0,
+                    t: stepper.t(),
+                    evaluated_until: k.until.get(),
+                    outputs: run.t.len(),
+                    next_grid: run.next_grid,
+                    events: run.events.len(),
+                    stats: run.stats,
+                    g_prev: run.g_prev.clone(),
+                });
+            }
+        }
     }
     if termination == Termination::Finished {
         let (t, y) = (stepper.t(), stepper.y().to_vec());
@@ -152,13 +432,13 @@ pub fn solve_observed(
         run.finish_at(t, &y);
     }
     Ok(Solution {
-        t: run.t,
-        y: run.y,
-        n,
-        events: run.events,
+        t: std::mem::take(&mut run.t),
+        y: std::mem::take(&mut run.y),
+        n: run.n,
+        events: std::mem::take(&mut run.events),
         stats: run.stats,
         t_final: run.t_final,
-        y_final: run.y_final,
+        y_final: std::mem::take(&mut run.y_final),
         termination,
     })
 }

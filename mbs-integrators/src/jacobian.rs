@@ -8,6 +8,7 @@ use crate::solution::Stats;
 use crate::stepper::{eval, non_finite};
 
 /// A Jacobian and the scratch space of its evaluation (nothing allocated per Jacobian).
+#[derive(Clone)]
 pub(crate) struct Jacobian {
     n: usize,
     /// `∂f/∂y`, n × n.

@@ -14,6 +14,11 @@
 //! solution on a uniform grid, and counts its work. Failures (step size below the minimum,
 //! non-finite state, Newton failure) are errors that say when and why.
 //!
+//! A TR-BDF2 solve can keep [`Checkpoint`]s ([`solve_checkpointed`]) and go on from one
+//! with another system ([`resume`]): where the two agree on everything the first was
+//! evaluated at before the checkpoint (a contact whose laws have not acted yet, say), the
+//! result is the other's own solve, to the last bit, for the cost of what follows it.
+//!
 //! [`MultibodyOde`] runs an `mbs_core::System`; its events name the element that raised them
 //! ([`Event::source`]) and, like every event, the way they crossed ([`Event::direction`],
 //! the core's [`Crossing`]: one crossing type for the core and the integrators).
@@ -64,7 +69,9 @@ mod solution;
 mod stepper;
 mod trbdf2;
 
-pub use driver::{solve, solve_observed, solve_with_events};
+pub use driver::{
+    Checkpoint, resume, solve, solve_checkpointed, solve_observed, solve_with_events,
+};
 pub use error::{IntegratorError, Result, SystemError};
 pub use interrupt::with_interrupt_check;
 pub use multibody::MultibodyOde;

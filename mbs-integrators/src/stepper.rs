@@ -20,6 +20,11 @@ pub(crate) trait Stepper {
     fn y(&self) -> &[f64];
     /// The dense-output state at `t` in `[t_prev, t]`.
     fn interpolate(&self, t: f64, out: &mut [f64]);
+    /// A copy of its whole state, to go on from later ([`crate::Checkpoint`]); `None` for
+    /// a method that does not offer it.
+    fn boxed_clone(&self) -> Option<Box<dyn Stepper + Send + Sync>> {
+        None
+    }
 }
 
 /// Evaluates the derivative, counting it and naming the time of a failure. Returns

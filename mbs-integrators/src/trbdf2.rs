@@ -52,6 +52,7 @@ const FIRST_DIVERGENT_RATE: f64 = 2.0;
 /// A contraction rate at or above this after the first estimate is divergence.
 const DIVERGENT_RATE: f64 = 0.9;
 
+#[derive(Clone)]
 pub(crate) struct TrBdf2 {
     ctl: Control,
     n: usize,
@@ -441,6 +442,10 @@ impl TrBdf2 {
 }
 
 impl Stepper for TrBdf2 {
+    fn boxed_clone(&self) -> Option<Box<dyn Stepper + Send + Sync>> {
+        Some(Box::new(self.clone()))
+    }
+
     fn start(&mut self, sys: &mut dyn OdeSystem, t: f64, y: &[f64], st: &mut Stats) -> Result<()> {
         self.t = t;
         self.t_prev = t;

@@ -346,6 +346,23 @@ impl ContactsParams {
         ]
     }
 
+    /// The contact of field name `name` (`backcheck`), to change; `None` for another name
+    /// (the hammer–string felt has a law of its own).
+    pub fn named_mut(&mut self, name: &str) -> Option<&mut ContactParams> {
+        Some(match name {
+            "front_rail" => &mut self.front_rail,
+            "back_rail" => &mut self.back_rail,
+            "capstan_heel" => &mut self.capstan_heel,
+            "jack_knuckle" => &mut self.jack_knuckle,
+            "lever_knuckle" => &mut self.lever_knuckle,
+            "let_off_button" => &mut self.let_off_button,
+            "drop_screw" => &mut self.drop_screw,
+            "backcheck" => &mut self.backcheck,
+            "rest_rail" => &mut self.rest_rail,
+            _ => return None,
+        })
+    }
+
     /// Checks every contact law: stiffness positive, exponent 1 to 5, restitution in
     /// (0, 1], friction 0 to 2, naming the contact and the field (`contacts.backcheck.e`);
     /// the hammer–string felt has no restitution and no friction.

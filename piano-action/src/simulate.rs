@@ -621,10 +621,68 @@ pub fn simulate_transformed(
         x0,
         rest_depth_mm,
     } = prepare_transformed(params, kind, input, transform)?;
+    let solution =
+        action.integrate_observed(&x0, duration_s, MAX_STEP_S, Some(output_step_s), progress)?;
+    run_of(params, kind, input, &action, solution, rest_depth_mm)
+}
+
+/// The longest step of a keystroke's integration (s) [D].
+const MAX_STEP_S: f64 = 1e-3;
+
+/// Simulates like [`simulate_transformed`] (without progress), to the same result to the
+/// last bit, but from a remembered run where one allows: a mass drop whose action differs
+/// from one simulated before only in the laws of contacts that had not yet acted goes on
+/// from that run's last checkpoint before they did (a fit that varies only the
+/// back-check's felt, or a finite difference in it, simulates only what follows the
+/// hammer's check). See [`crate::action::resumed_or_solved`].
+pub fn simulate_transformed_resuming(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    duration_s: f64,
+    output_step_s: f64,
+    transform: Option<Transform<'_>>,
+) -> Result<Run> {
+    check_duration(duration_s, output_step_s)?;
+    let Prepared {
+        action,
+        x0,
+        rest_depth_mm,
+    } = prepare_transformed(params, kind, input, transform)?;
+    let solution = if matches!(input, Input::MassDrop { .. }) {
+        crate::action::resumed_or_solved(
+            &action,
+            input,
+            &x0,
+            duration_s,
+            MAX_STEP_S,
+            output_step_s,
+        )?
+        .0
+    } else {
+        action.integrate_observed(
+            &x0,
+            duration_s,
+            MAX_STEP_S,
+            Some(output_step_s),
+            &mut |_| {},
+        )?
+    };
+    run_of(params, kind, input, &action, solution, rest_depth_mm)
+}
+
+/// The run of `action` (assembled for `input` from `params`) from its `solution`: the
+/// strikes, the events by name, the key drive's force.
+fn run_of(
+    params: &ActionParams,
+    kind: ModelKind,
+    input: &Input,
+    action: &Action,
+    solution: Solution,
+    rest_depth_mm: f64,
+) -> Result<Run> {
     let model = action.system.model().clone();
     let nv = model.nv();
-    let solution =
-        action.integrate_observed(&x0, duration_s, 1e-3, Some(output_step_s), progress)?;
     let mut key_drive_force_n = Vec::new();
     if matches!(input, Input::Motion { .. }) {
         let key = model.coordinate_id("key")?;

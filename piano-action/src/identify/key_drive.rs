@@ -23,7 +23,7 @@ use crate::action::Transform;
 use crate::error::{PianoError, Result};
 use crate::key::KeyGeometry;
 use crate::params::ActionParams;
-use crate::simulate::{Input, prepare_transformed, simulate_transformed};
+use crate::simulate::{Input, prepare_transformed, simulate_transformed_resuming};
 
 /// The experiment's name in `dataset.json`.
 pub const EXPERIMENT: &str = "key_drive";
@@ -246,10 +246,10 @@ pub(super) fn simulate_effect(
     effect: Option<&ActionEffect>,
 ) -> Result<crate::simulate::Run> {
     match effect {
-        None => simulate_transformed(params, kind, input, duration_s, 2e-5, None, &mut |_| {}),
+        None => simulate_transformed_resuming(params, kind, input, duration_s, 2e-5, None),
         Some(e) => {
             let f = |m: &mbs_mechanism::Mechanism| e.apply(m, params);
-            simulate_transformed(params, kind, input, duration_s, 2e-5, Some(&f), &mut |_| {})
+            simulate_transformed_resuming(params, kind, input, duration_s, 2e-5, Some(&f))
         }
     }
 }
