@@ -155,9 +155,11 @@ pub fn solve_checkpointed(
 /// Goes on from `checkpoint`, taken in the solve that gave `base` ([`solve_checkpointed`]),
 /// with the system `sys` up to `t_end`: `base`'s output and events up to the checkpoint,
 /// then `sys`'s. When `sys` agrees with the system `base` was solved with wherever that one
-/// was evaluated before [`Checkpoint::evaluated_until`], the result is `sys`'s own solve
-/// from `base`'s start, to the last bit (its work counts included). Fails when `opts` or
-/// `method` differ from the checkpoint's, or when `base` is shorter than it.
+/// was evaluated before [`Checkpoint::evaluated_until`] (the same number of states, the
+/// same rates and Jacobians there), and `t_end` is `base`'s (a step clipped to reach an
+/// end, then rejected, leaves its mark on the steps that follow), the result is `sys`'s
+/// own solve from `base`'s start, to the last bit (its work counts included). Fails when
+/// `opts` or `method` differ from the checkpoint's, or when `base` is shorter than it.
 #[allow(clippy::too_many_arguments)]
 pub fn resume(
     sys: &mut dyn OdeSystem,

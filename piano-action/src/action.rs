@@ -450,6 +450,10 @@ const RUNS_REMEMBERED: usize = 6;
 /// held 1.2 GB and its refits on every run went no faster).
 const CHECKPOINT_EVERY_S: f64 = 10e-3;
 
+/// The most checkpoints a remembered run keeps [D]: a longer run keeps them further
+/// apart (each holds the method's Jacobian and factorisation).
+const CHECKPOINTS_MAX: usize = 64;
+
 /// The contacts of `b` whose laws or friction differ from `a`'s (by name), when the two
 /// hold the same contacts between the same shapes; `None` otherwise.
 fn contacts_whose_laws_differ(
@@ -551,7 +555,7 @@ pub(crate) fn resumed_or_solved(
         &opts,
         &mut |_, _| EventAction::Record,
         &mut |_| {},
-        CHECKPOINT_EVERY_S,
+        CHECKPOINT_EVERY_S.max(t_end / CHECKPOINTS_MAX as f64),
     )
     .map_err(crate::PianoError::from)?;
     let acted_from = action
@@ -621,7 +625,13 @@ fn without_laws(
         }
     }
     for c in m.contacts.iter_mut().filter(|c| contacts.contains(&c.name)) {
-        c.law = mbs_mechanism::LawSpec::Material(String::new());
+        // The placeholder keeps how many states the law adds (they change the state
+        // vector, and a law with states acts from the start); a law that does not build
+        // stays as it is, and matches only itself.
+        use mbs_contact::laws::NormalLaw;
+        if let Ok(law) = mbs_mechanism::normal_law(&c.name, &c.law) {
+            c.law = mbs_mechanism::LawSpec::Material(format!("{} states", law.state_count()));
+        }
         c.friction = None;
         c.note.clear();
     }
@@ -719,6 +729,21 @@ mod tests {
             settled, q,
             "a softer back-rail cloth leaves the key where it was"
         );
+        // A back-check of a law with a state (Stulov's felt) acts from the start and takes
+        // the system's Jacobian by differences: it settles on its own, whatever is
+        // remembered for the file's back-check.
+        let stulov = |m: &mbs_mechanism::Mechanism| -> Result<mbs_mechanism::Mechanism> {
+            let mut m = m.clone();
+            for c in m.contacts.iter_mut().filter(|c| c.name == "backcheck") {
+                c.law = mbs_mechanism::LawSpec::Material("hammer_felt_Stulov".into());
+            }
+            Ok(m)
+        };
+        let remembered = Action::rest_coordinates_transformed(&file, kind, &stulov).unwrap();
+        let mechanism = stulov(&crate::describe::grand_mechanism(&file, kind, None).unwrap());
+        let own = Action::from_mechanism(&file, kind, None, &mechanism.unwrap()).unwrap();
+        assert_eq!(remembered, own.settled_coordinates().unwrap());
+        assert!(own.contacts_not_touched().iter().all(|c| c != "backcheck"));
     }
 
     /// A mass drop whose back-check differs from one simulated before goes on from that
