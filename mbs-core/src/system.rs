@@ -411,6 +411,14 @@ impl System {
 
     /// Loads q, v (drives applied) and runs kinematics.
     fn prepare(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<()> {
+        self.prepare_kinematics(ws, t, x)?;
+        self.position_stage(ws, t);
+        Ok(())
+    }
+
+    /// [`System::prepare`] without the position stage: the poses and velocities alone, for
+    /// outputs that read no element's results.
+    fn prepare_kinematics(&self, ws: &mut Workspace, t: f64, x: &[f64]) -> Result<()> {
         if ws.q.len() != self.model.nv() || ws.forces_world.len() != self.model.nbodies() {
             return Err(CoreError::WorkspaceMismatch {
                 expected: self.model.nbodies(),
@@ -430,7 +438,6 @@ impl System {
             }
         }
         kinematics_pass(&self.model, &mut ws.data, &ws.q, Some(&ws.v));
-        self.position_stage(ws, t);
         Ok(())
     }
 
@@ -942,7 +949,8 @@ impl System {
         t: f64,
         x: &'a [f64],
     ) -> Result<ForceContext<'a>> {
-        self.prepare(ws, t, x)?;
+        // No element's results: the contacts' nearest points are not searched.
+        self.prepare_kinematics(ws, t, x)?;
         Ok(self.context(&ws.data, &ws.q, &ws.v, t, &x[..0], &[]))
     }
 

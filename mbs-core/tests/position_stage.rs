@@ -119,4 +119,13 @@ fn pose_results_are_computed_once_per_state() {
     // The system's kinematics for outputs need no element results.
     system.kinematics(&mut ws, 0.2, &xq).unwrap();
     assert_eq!(count(), 5);
+    let mut xk = xq.clone();
+    xk[0] += 1e-3;
+    system.kinematics(&mut ws, 0.3, &xk).unwrap();
+    assert_eq!(count(), 5);
+    // ... and leave the cache of the coordinates it was computed at.
+    system.derivative(&mut ws, 0.2, &xq, &mut xdot).unwrap();
+    assert_eq!(count(), 5);
+    system.derivative(&mut ws, 0.3, &xk, &mut xdot).unwrap();
+    assert_eq!(count(), 6);
 }
