@@ -43,7 +43,7 @@ use rayon::prelude::*;
 use mbs_identify::explain::{NoiseCheck, NoiseCheckOptions, RunResiduals, Window, check_noise};
 use mbs_identify::lm::{FreeParam, LmFit, LmOptions, levenberg_marquardt};
 use mbs_identify::noise::{self, Ar1};
-use mbs_identify::stats::{chi2_sf, conditional_sd};
+use mbs_identify::stats::{chi2_isf, chi2_sf, conditional_sd};
 use mbs_identify::work::{StageClock, StageWork, WorkCounter};
 use mbs_identify::{Camera, Dataset, EffectSpec, Role};
 use serde::Serialize;
@@ -1502,32 +1502,10 @@ fn beyond_every_cell(check: &NoiseCheck, rows: usize, margin: f64) -> bool {
         .iter()
         .map(|c| {
             let k = c.n as f64;
-            (options.floors.powi(2) * k).max(chi2_upper(options.cell_p, k))
+            (options.floors.powi(2) * k).max(chi2_isf(options.cell_p, k))
         })
         .sum();
     sum > margin * most
-}
-
-/// The value a χ² of `k` degrees of freedom exceeds with probability `p` (bisection on
-/// [`chi2_sf`], to a millionth of `k`).
-fn chi2_upper(p: f64, k: f64) -> f64 {
-    if !(p > 0.0 && p < 1.0 && k > 0.0) {
-        return f64::NAN;
-    }
-    let (mut lo, mut hi) = (0.0, k.max(1.0));
-    while chi2_sf(hi, k) > p {
-        lo = hi;
-        hi *= 2.0;
-    }
-    while hi - lo > 1e-6 * k.max(1.0) {
-        let mid = 0.5 * (lo + hi);
-        if chi2_sf(mid, k) > p {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
 }
 
 /// How far a joint refit moved the values held at the file's within their tolerances.
@@ -3355,21 +3333,6 @@ fn onset_of(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The χ² a cell reaches by chance, against tables: 30.144 for 19 degrees of freedom
-    /// at 5 % (the inflation's bound), 13.816 for 2 and 149.449 for 100 at one in a
-    /// thousand.
-    #[test]
-    fn the_chi2_upper_quantile_matches_the_tables() {
-        for (p, k, q) in [
-            (0.05, 19.0, 30.144),
-            (1e-3, 2.0, 13.816),
-            (1e-3, 100.0, 149.449),
-        ] {
-            let x = chi2_upper(p, k);
-            assert!((x - q).abs() < 2e-3, "χ²({k}) at {p}: {x}, tables {q}");
-        }
-    }
 
     /// A refit whose runs leave more than their cells may hold and all pass is beyond every
     /// cell: one cell of 200 residuals may hold 4 × 200 = 800 (its χ² at one in a
