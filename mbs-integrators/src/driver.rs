@@ -91,6 +91,7 @@ pub struct Checkpoint {
     outputs: usize,
     next_grid: usize,
     events: usize,
+    step_ends: usize,
     stats: Stats,
     g_prev: Vec<f64>,
 }
@@ -182,6 +183,7 @@ pub fn resume(
         || base.t.len() < checkpoint.outputs
         || base.y.len() < checkpoint.outputs * n
         || base.events.len() < checkpoint.events
+        || base.step_ends.len() < checkpoint.step_ends
         || sys.event_count() != checkpoint.g_prev.len()
     {
         return Err(IntegratorError::InvalidInitialCondition(
@@ -207,6 +209,8 @@ pub fn resume(
     run.y.extend_from_slice(&base.y[..checkpoint.outputs * n]);
     run.events
         .extend_from_slice(&base.events[..checkpoint.events]);
+    run.step_ends
+        .extend_from_slice(&base.step_ends[..checkpoint.step_ends]);
     run.next_grid = checkpoint.next_grid;
     run.stats = checkpoint.stats;
     run.g_prev.copy_from_slice(&checkpoint.g_prev);
@@ -381,6 +385,9 @@ fn go_on(
         }
         stepper.step(run.sys, t_end, &mut run.stats)?;
         let t_reached = stepper.t();
+        if opts.record_steps {
+            run.step_ends.push(t_reached);
+        }
         progress(t_reached);
         match run.scan_events(stepper.as_ref(), handler)? {
             None => {
@@ -389,6 +396,14 @@ fn go_on(
             }
             Some((t_event, action, y_event)) => {
                 run.output_until(stepper.as_ref(), t_event, false);
+                // The step, cut back, ends at the event (none is left if that is where
+                // the one before ended).
+                if opts.record_steps {
+                    run.step_ends.pop();
+                    if run.step_ends.last().is_none_or(|&e| e < t_event) {
+                        run.step_ends.push(t_event);
+                    }
+                }
                 if action == EventAction::Stop {
                     run.output_point_if_stepwise(t_event, &y_event);
                     run.finish_at(t_event, &y_event);
@@ -417,6 +432,7 @@ fn go_on(
                     outputs: run.t.len(),
                     next_grid: run.next_grid,
                     events: run.events.len(),
+                    step_ends: run.step_ends.len(),
                     stats: run.stats,
                     g_prev: run.g_prev.clone(),
                 });
@@ -442,6 +458,7 @@ fn go_on(
         t_final: run.t_final,
         y_final: std::mem::take(&mut run.y_final),
         termination,
+        step_ends: std::mem::take(&mut run.step_ends),
     })
 }
 
@@ -457,6 +474,7 @@ struct Run<'s> {
     t: Vec<f64>,
     y: Vec<f64>,
     events: Vec<Event>,
+    step_ends: Vec<f64>,
     stats: Stats,
     m: usize,
     g_prev: Vec<f64>,
@@ -483,6 +501,7 @@ impl<'s> Run<'s> {
             t: Vec::new(),
             y: Vec::new(),
             events: Vec::new(),
+            step_ends: Vec::new(),
             stats: Stats::default(),
             m,
             g_prev: vec![0.0; m],

@@ -85,6 +85,21 @@ pub struct Options {
     /// two crossings of one function within a step are seen when they are at least a
     /// sub-interval apart.
     pub event_samples: usize,
+    /// Step ends to follow (TR-BDF2 only; strictly ascending, finite): every step ends at
+    /// the next of them after its start (or at `t_end`), with error control off and the
+    /// stages solved as with a fixed step; a step whose stages Newton cannot solve is
+    /// tried again a quarter as long, towards the same end. Take them from an adaptive
+    /// solve's [`crate::Solution::step_ends`] at nearby parameters: finite differences
+    /// between solves on one mesh then see no step-size decision, only the parameters
+    /// (Bock's internal numerical differentiation: H. G. Bock, "Numerical treatment of
+    /// inverse problems in chemical reaction kinetics", *Modelling of Chemical Reaction
+    /// Systems*, Springer 1981). The steps are as accurate as that solve's only while
+    /// the motion stays close to its own.
+    pub mesh: Option<std::sync::Arc<[f64]>>,
+    /// Whether the solution records where each accepted step ended
+    /// ([`crate::Solution::step_ends`], a mesh for [`Options::mesh`]); default false (like
+    /// output points, they are stored, so a step that records one may allocate).
+    pub record_steps: bool,
 }
 
 impl Default for Options {
@@ -100,6 +115,8 @@ impl Default for Options {
             output_step: None,
             event_tolerance: 1e-12,
             event_samples: 4,
+            mesh: None,
+            record_steps: false,
         }
     }
 }
@@ -175,6 +192,31 @@ impl Options {
                 );
             }
             _ => {}
+        }
+        if let Some(mesh) = &self.mesh {
+            if method != Method::TrBdf2 {
+                return bad(
+                    "mesh",
+                    format!("{method:?} cannot follow a mesh (TR-BDF2 can)"),
+                );
+            }
+            if self.fixed_step.is_some() {
+                return bad("mesh", "set a mesh or a fixed step, not both".into());
+            }
+            if let Some(i) = mesh.iter().position(|t| !t.is_finite()) {
+                return bad("mesh", format!("step end {i} is {}", mesh[i]));
+            }
+            if let Some(i) = mesh.windows(2).position(|w| w[1] <= w[0]) {
+                return bad(
+                    "mesh",
+                    format!(
+                        "step ends must be strictly ascending: {} then {} (at {})",
+                        mesh[i],
+                        mesh[i + 1],
+                        i + 1
+                    ),
+                );
+            }
         }
         if let Some(dt) = self.output_step
             && !positive(dt)

@@ -84,6 +84,10 @@ pub struct Solution {
     pub y_final: Vec<f64>,
     /// Why the solve ended.
     pub termination: Termination,
+    /// Where each accepted step ended (after a restart at an event, the event's time in
+    /// place of the step's), when [`crate::Options::record_steps`] asked: strictly
+    /// ascending, a mesh for [`crate::Options::mesh`]. Empty otherwise.
+    pub step_ends: Vec<f64>,
 }
 
 impl Solution {

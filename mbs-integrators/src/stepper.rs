@@ -61,6 +61,8 @@ pub(crate) struct Control {
     pub h_init: Option<f64>,
     pub h_max: f64,
     pub fixed: Option<f64>,
+    /// Step ends to follow ([`Options::mesh`]).
+    pub mesh: Option<std::sync::Arc<[f64]>>,
     opts: Options,
 }
 
@@ -72,8 +74,25 @@ impl Control {
             h_init: opts.initial_step,
             h_max: opts.max_step,
             fixed: opts.fixed_step,
+            mesh: opts.mesh.clone(),
             opts: opts.clone(),
         }
+    }
+
+    /// Whether steps are chosen without an error estimate (a fixed step or a mesh).
+    pub fn unchecked(&self) -> bool {
+        self.fixed.is_some() || self.mesh.is_some()
+    }
+
+    /// On a mesh, the step from `t` to its next end after `t` (or to `t_max`).
+    pub fn mesh_step(&self, t: f64, t_max: f64) -> Option<f64> {
+        let mesh = self.mesh.as_ref()?;
+        // An end within round-off of `t` is the one just reached.
+        let reached = t + 1e-12 * t.abs().max(1e-3);
+        let next = mesh[mesh.partition_point(|&e| e <= reached)..]
+            .first()
+            .map_or(t_max, |&e| e.min(t_max));
+        Some(next - t)
     }
 
     pub fn h_min(&self, t: f64) -> f64 {

@@ -32,10 +32,10 @@ const W: f64 = SQRT2 / 4.0;
 const E0: f64 = (1.0 - 4.0 * W) / 3.0;
 const E1: f64 = 1.0 / 3.0;
 const E2: f64 = -2.0 * D / 3.0;
-/// Newton: maximum iterations per stage (more with a fixed step, which cannot shrink
-/// instead), and the convergence threshold on the weighted norm of the remaining
-/// correction. With a fixed step the tolerances still set how exactly the stages are
-/// solved.
+/// Newton: maximum iterations per stage (more with a fixed step or on a mesh, whose step
+/// is not chosen by it), and the convergence threshold on the weighted norm of the
+/// remaining correction. With a fixed step or a mesh the tolerances still set how exactly
+/// the stages are solved.
 const NEWTON_MAX: usize = 8;
 const NEWTON_MAX_FIXED: usize = 20;
 const NEWTON_TOL: f64 = 0.03;
@@ -285,7 +285,7 @@ impl TrBdf2 {
     ) -> Result<Stage> {
         let mut prev = f64::INFINITY;
         let mut rate: f64 = 1.0;
-        let max_iterations = if self.ctl.fixed.is_some() {
+        let max_iterations = if self.ctl.unchecked() {
             NEWTON_MAX_FIXED
         } else {
             NEWTON_MAX
@@ -322,7 +322,9 @@ impl TrBdf2 {
             }
             if k > 0 {
                 rate = norm / prev;
-                // With a fixed step no error estimate checks the stages: no leniency.
+                // With a fixed step no error estimate checks the stages and nothing else
+                // would catch a wrong convergence: no leniency. (On a mesh, a step the
+                // adaptive solve accepted.)
                 let limit = if k == 1 && self.ctl.fixed.is_none() {
                     FIRST_DIVERGENT_RATE
                 } else {
@@ -458,9 +460,11 @@ impl Stepper for TrBdf2 {
         self.f_evaluated = true;
         self.live_chosen = false;
         if self.h == 0.0 {
-            self.h = match self.ctl.fixed {
-                Some(h) => h,
-                None => self.ctl.initial_step(sys, t, y, &self.f, 2, st)?,
+            self.h = match (self.ctl.fixed, &self.ctl.mesh) {
+                (Some(h), _) => h,
+                // The mesh sets every step.
+                (None, Some(_)) => f64::INFINITY,
+                (None, None) => self.ctl.initial_step(sys, t, y, &self.f, 2, st)?,
             };
         }
         // After a restart (event) the old Jacobian may be far off: refresh lazily.
@@ -476,9 +480,14 @@ impl Stepper for TrBdf2 {
         // Remedies tried at this step size: 0 none, 1 fresh Jacobian at the step start,
         // 2 and more: Jacobians at the failing stage points (fixed step only, up to 4).
         let mut remedies = 0;
+        // On a mesh: the step to its next end, or a quarter of the last that failed.
+        let mut shorter = f64::INFINITY;
         loop {
             let h_min = self.ctl.h_min(self.t);
-            let (h, _) = clip_step(self.t, self.h.min(self.ctl.h_max), t_max);
+            let h = match self.ctl.mesh_step(self.t, t_max) {
+                Some(to_end) => to_end.min(shorter),
+                None => clip_step(self.t, self.h.min(self.ctl.h_max), t_max).0,
+            };
             if !self.attempt(sys, h, st)? {
                 st.newton_failures += 1;
                 if !self.jac_fresh && remedies == 0 {
@@ -487,7 +496,7 @@ impl Stepper for TrBdf2 {
                     self.update_jacobian(sys, st)?;
                     continue;
                 }
-                if remedies < 4 && self.ctl.fixed.is_some() {
+                if remedies < 4 && self.ctl.unchecked() {
                     // Then, when the step cannot shrink: a Jacobian where Newton
                     // struggled (the stage point).
                     remedies = remedies.max(1) + 1;
@@ -496,7 +505,15 @@ impl Stepper for TrBdf2 {
                     }
                 }
                 remedies = 0;
-                if self.ctl.fixed.is_some() || 0.25 * h < h_min {
+                if self.ctl.mesh.is_some() && 0.25 * h >= h_min {
+                    // Towards the same end in shorter steps, chosen as deterministically
+                    // as the mesh.
+                    st.rejected += 1;
+                    st.rejected_newton += 1;
+                    shorter = 0.25 * h;
+                    continue;
+                }
+                if self.ctl.unchecked() || 0.25 * h < h_min {
                     return Err(IntegratorError::NewtonFailure { t: self.t, h });
                 }
                 st.rejected += 1;
@@ -505,7 +522,7 @@ impl Stepper for TrBdf2 {
                 self.h = 0.25 * h;
                 continue;
             }
-            if self.ctl.fixed.is_some() {
+            if self.ctl.unchecked() {
                 self.accept(h, st);
                 return Ok(());
             }

@@ -34,9 +34,11 @@ impl OdeSystem for Pushed {
     }
 }
 
+/// With the step ends recorded, so that a resumed solve's are checked too.
 fn options() -> Options {
     Options {
         output_step: Some(1e-3),
+        record_steps: true,
         ..Options::with_tolerances(1e-6, 1e-9)
     }
 }
@@ -74,6 +76,7 @@ fn a_resumed_solve_is_the_other_systems_own_solve() {
     )
     .unwrap();
     assert_eq!(base, full(1.0));
+    assert_eq!(base.step_ends.len(), base.stats.steps);
     assert!(base.events.len() >= 4, "{} events", base.events.len());
     assert!(checkpoints.len() >= 18, "{} checkpoints", checkpoints.len());
     assert!(checkpoints.windows(2).all(|w| w[0].t < w[1].t));
