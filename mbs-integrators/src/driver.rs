@@ -320,6 +320,17 @@ fn begin<'s>(
     opts: &Options,
 ) -> Result<(Box<dyn Stepper + 's>, Run<'s>)> {
     opts.validate(method)?;
+    if let Some(mesh) = &opts.mesh
+        && mesh.last().is_none_or(|&last| last < t_end * (1.0 - 1e-12))
+    {
+        return Err(IntegratorError::InvalidOption {
+            option: "mesh",
+            message: format!(
+                "it ends at {} s, before the solve's end {t_end} s",
+                mesh.last().copied().unwrap_or(f64::NAN)
+            ),
+        });
+    }
     let n = sys.len();
     if y0.len() != n {
         return Err(IntegratorError::InvalidInitialCondition(format!(

@@ -85,7 +85,8 @@ pub struct Options {
     /// two crossings of one function within a step are seen when they are at least a
     /// sub-interval apart.
     pub event_samples: usize,
-    /// Step ends to follow (TR-BDF2 only; strictly ascending, finite): every step ends at
+    /// Step ends to follow (TR-BDF2 only; strictly ascending, finite, the last at or past
+    /// the solve's end, else the solve is refused): every step ends at
     /// the next of them after its start (or at `t_end`), with error control off and the
     /// stages solved as with a fixed step; a step whose stages Newton cannot solve is
     /// tried again a quarter as long, towards the same end. Take them from an adaptive

@@ -288,8 +288,9 @@ fn step_ends_are_a_mesh_across_restarts_and_a_solve_follows_it() {
 
 #[test]
 fn a_bad_mesh_is_refused_by_name() {
-    let cases: [(Method, Vec<f64>, Option<f64>); 4] = [
+    let cases: [(Method, Vec<f64>, Option<f64>); 5] = [
         (Method::TrBdf2, vec![0.1, 0.1, 0.2], None),
+        (Method::TrBdf2, vec![0.1, 0.5], None),
         (Method::TrBdf2, vec![0.1, f64::NAN], None),
         (Method::TrBdf2, vec![0.1, 0.2], Some(0.01)),
         (Method::DormandPrince54, vec![0.1, 0.2], None),
